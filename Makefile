@@ -1,0 +1,81 @@
+# libvpds: every entry point of the project. `make test` is what CI runs.
+CC      ?= gcc
+PREFIX  ?= /usr/local
+VERSION := 1.0.0
+SOMAJOR := 1
+BUILD   ?= build
+OPT     ?= -O2
+WARN    := -std=c99 -Wall -Wextra -Wpedantic -Werror
+# No FMA contraction and no fast-math: a seed gives the same bytes on every build.
+CFLAGS_LIB := $(WARN) $(OPT) -g -fPIC -fvisibility=hidden -ffp-contract=off -Iinclude $(EXTRA_CFLAGS)
+CFLAGS_TEST := $(WARN) $(OPT) -g -ffp-contract=off -Iinclude -Ilibvpds -Itests $(EXTRA_CFLAGS)
+
+LIB_SRC := $(sort $(wildcard libvpds/*.c))
+LIB_OBJ := $(LIB_SRC:libvpds/%.c=$(BUILD)/obj/%.o)
+LIB_HDR := include/vpds.h $(wildcard libvpds/*.h)
+SHARED  := $(BUILD)/libvpds.so.$(VERSION)
+STATIC  := $(BUILD)/libvpds.a
+
+TEST_SRC := $(sort $(wildcard tests/test_*.c))
+TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
+FLANN_TEST := $(BUILD)/tests/flann_kdtree
+
+.PHONY: all test demo deps install clean bench check-c check-flann
+all: $(SHARED) $(STATIC) $(BUILD)/vpds.pc
+
+$(BUILD)/obj/%.o: libvpds/%.c $(LIB_HDR)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_LIB) -c $< -o $@
+
+$(SHARED): $(LIB_OBJ) libvpds/vpds.map
+	$(CC) -shared -Wl,-soname,libvpds.so.$(SOMAJOR) -Wl,--version-script=libvpds/vpds.map \
+	  -o $@ $(LIB_OBJ) -lm
+	ln -sf libvpds.so.$(VERSION) $(BUILD)/libvpds.so.$(SOMAJOR)
+	ln -sf libvpds.so.$(SOMAJOR) $(BUILD)/libvpds.so
+
+$(STATIC): $(LIB_OBJ)
+	rm -f $@
+	ar rcs $@ $(LIB_OBJ)
+
+$(BUILD)/vpds.pc: libvpds/vpds.pc.in
+	@mkdir -p $(BUILD)
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' $< > $@
+
+$(BUILD)/tests/%: tests/%.c tests/check.h $(STATIC)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_TEST) $< -o $@ $(STATIC) -lm
+
+$(FLANN_TEST): tests/flann_kdtree.c tests/check.h $(STATIC)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_TEST) $< -o $@ $(STATIC) -lflann -lm
+
+$(BUILD)/demo/figure1: examples/figure1.c $(STATIC)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_TEST) $< -o $@ $(STATIC) -lm
+
+check-c: $(TEST_BIN)
+	@set -e; for t in $(TEST_BIN); do echo "== $$t"; $$t; done
+
+check-flann: $(FLANN_TEST)
+	$(FLANN_TEST)
+
+test: all check-c check-flann
+	@echo "all tests passed"
+
+demo: $(BUILD)/demo/figure1
+	$(BUILD)/demo/figure1 $(BUILD)/demo
+
+deps:
+	bash tools/deps.sh
+
+install: all
+	install -d $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig
+	install -m 644 include/vpds.h $(DESTDIR)$(PREFIX)/include/vpds.h
+	install -m 755 $(SHARED) $(DESTDIR)$(PREFIX)/lib/
+	ln -sf libvpds.so.$(VERSION) $(DESTDIR)$(PREFIX)/lib/libvpds.so.$(SOMAJOR)
+	ln -sf libvpds.so.$(SOMAJOR) $(DESTDIR)$(PREFIX)/lib/libvpds.so
+	install -m 644 $(STATIC) $(DESTDIR)$(PREFIX)/lib/
+	install -m 644 $(BUILD)/vpds.pc $(DESTDIR)$(PREFIX)/lib/pkgconfig/vpds.pc
+
+clean:
+	rm -rf $(BUILD)

@@ -1,0 +1,228 @@
+/*
+ * libvpds: maximal Poisson-disk sampling with spatially varying radii, in any dimension.
+ *
+ * Implements "Variable Radii Poisson-Disk Sampling" (Mitchell, Ebeida et al.): Algorithm 1 with
+ * the four distance rules of Section 5, decoupled inhibition/coverage radii (Section 3) and
+ * hierarchical refinement (Section 4).
+ *
+ * Definitions used throughout (scale t, rule f, sizing r):
+ *   a point y CONFLICTS with sample x_i when |y - x_i| <  t * inhibition * f(x_i, y)
+ *   a point y is COVERED by sample x_i when |y - x_i| <= t * coverage   * f(x_i, y)
+ *   f(x, y) = r(x) (prior), r(y) (current), max(r(x), r(y)) (bigger), min(r(x), r(y)) (smaller).
+ * A run ends with every sample free of conflict with the samples before it (insertion order)
+ * and every point of the box covered, up to the precision reported in vpds_stats.delta.
+ *
+ * Usage: fill a descriptor from vpds_default_desc(), change what you need, vpds_create(),
+ * vpds_run(), read vpds_points()/vpds_count(), vpds_destroy(). No global state: one sampler per
+ * thread needs no locks. The library never prints, exits or aborts.
+ */
+#ifndef VPDS_H
+#define VPDS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(_WIN32) && defined(VPDS_BUILD_SHARED)
+#define VPDS_API __declspec(dllexport)
+#elif defined(_WIN32) && defined(VPDS_SHARED)
+#define VPDS_API __declspec(dllimport)
+#elif defined(__GNUC__)
+#define VPDS_API __attribute__((visibility("default")))
+#else
+#define VPDS_API
+#endif
+
+#define VPDS_VERSION_MAJOR 1
+#define VPDS_VERSION_MINOR 0
+#define VPDS_VERSION_PATCH 0
+/* The points a seed gives are fixed for one algorithm version; pin it in vpds_desc to keep them. */
+#define VPDS_ALGORITHM_VERSION 1
+/* Largest supported dimension; a larger dim is refused by vpds_create. */
+#define VPDS_MAX_DIM 8
+/* Value of vpds_desc.lipschitz meaning "not given". */
+#define VPDS_UNSET (-1.0)
+
+/* Status codes: 0 is success, positive values are non-error outcomes, negative are errors. */
+typedef enum vpds_status {
+    VPDS_OK = 0,
+    VPDS_PAUSED = 1,      /* a budget or the progress callback stopped the run: call it again */
+    VPDS_STREAM_END = 2,  /* vpds_next: the next event lies at or below t_min; nothing consumed */
+    VPDS_ERR_INVALID_ARGUMENT = -1, /* an argument or descriptor field is out of range */
+    VPDS_ERR_BAD_DESCRIPTOR = -2,   /* not from vpds_default_desc(), or a layout not known */
+    VPDS_ERR_OUT_OF_MEMORY = -3,    /* the allocator returned NULL; the sampler is unchanged */
+    VPDS_ERR_UNSUPPORTED = -4,      /* a capability this version does not provide */
+    VPDS_ERR_SIZING = -5,           /* the sizing function returned NaN, Inf, zero or < 0 */
+    VPDS_ERR_LIPSCHITZ = -6,        /* the sizing function was seen to break the declared L */
+    VPDS_ERR_STATE = -7,            /* the call is not valid in the sampler's current state */
+    VPDS_ERR_OVERFLOW = -8          /* the request would overflow a size computation */
+} vpds_status;
+
+/* The distance function f of Section 5 (Table 1). */
+typedef enum vpds_rule {
+    VPDS_RULE_DEFAULT = 0, /* = VPDS_RULE_SMALLER, the paper's recommendation */
+    VPDS_RULE_PRIOR = 1,   /* f = r(x_i); needs L < 1/2 */
+    VPDS_RULE_CURRENT = 2, /* f = r(y); needs L < 1 */
+    VPDS_RULE_BIGGER = 3,  /* f = max(r(x_i), r(y)); needs L < 1/2 */
+    VPDS_RULE_SMALLER = 4  /* f = min(r(x_i), r(y)); needs L < 1 */
+} vpds_rule;
+
+/* Memory comes from here. alloc and free are both set or both NULL (NULL: malloc/free).
+ * realloc is optional (NULL: alloc, copy, free); it must keep the contents like C's realloc. */
+typedef struct vpds_allocator {
+    void *(*alloc)(size_t size, void *user);
+    void *(*realloc)(void *ptr, size_t old_size, size_t new_size, void *user);
+    void (*free)(void *ptr, size_t size, void *user);
+    void *user;
+} vpds_allocator;
+
+/* r(x) > 0 at a point x of dim coordinates. */
+typedef double (*vpds_sizing_fn)(const double *x, void *user);
+/* r at n points (x holds n*dim doubles); write n radii to r_out; return 0, or non-zero to fail. */
+typedef int (*vpds_sizing_batch_fn)(const double *x, size_t n, double *r_out, void *user);
+/* Signed distance to the domain's boundary, negative inside, 1-Lipschitz. */
+typedef double (*vpds_domain_fn)(const double *x, void *user);
+
+/* Passed to the progress callback between chunks of work. */
+typedef struct vpds_progress {
+    uint64_t darts;          /* darts thrown so far in this sampler */
+    size_t samples;          /* samples held (fixed points included) */
+    uint64_t active_cells;   /* cells still active at the current level */
+    uint32_t level;          /* current level of the flat hyper-octree */
+    double t;                /* scale being sampled */
+} vpds_progress;
+/* Return 0 to go on, non-zero to pause (the call then returns VPDS_PAUSED). */
+typedef int (*vpds_progress_fn)(const vpds_progress *progress, void *user);
+
+/* A regular grid of radii with multilinear interpolation (see vpds_grid_create). */
+typedef struct vpds_grid vpds_grid;
+
+/* The sampler's descriptor. Always start from vpds_default_desc(): the cookie and size in the
+ * first two fields let the library refuse a struct that did not come from it. */
+typedef struct vpds_desc {
+    uint32_t cookie;      /* set by vpds_default_desc; do not change */
+    uint32_t struct_size; /* set by vpds_default_desc; do not change */
+
+    int dim;              /* 1..VPDS_MAX_DIM (default 2) */
+    const double *lo;     /* dim doubles: the box's lower corner (NULL: all 0) */
+    const double *hi;     /* dim doubles: the box's upper corner (NULL: all 1) */
+    const int *periodic;  /* dim ints, non-zero for a toroidal axis (NULL: none) */
+
+    /* Radius: constant `radius` unless a sizing function is given (callback, batch or grid). */
+    double radius;                     /* default 0.05 */
+    vpds_sizing_fn sizing;
+    vpds_sizing_batch_fn sizing_batch; /* optional faster form of sizing; used when set */
+    void *sizing_user;
+    const vpds_grid *sizing_grid;      /* copied at vpds_create; its L is computed */
+    double lipschitz;   /* L of r; VPDS_UNSET by default; required with a callback */
+    double radius_min;  /* optional lower bound of r (0: unknown); needed by `weighted` + callback */
+    double radius_max;  /* optional upper bound of r (0: derived from L and the box) */
+    vpds_rule rule;
+
+    double inhibition;  /* R_f factor (default 1) */
+    double coverage;    /* R_c factor (default 1), inhibition <= coverage */
+    int weighted;       /* non-zero: weighted-bias-free process, density 1/r^d (Eq. 12) */
+
+    vpds_domain_fn domain; /* NULL: the whole box */
+    void *domain_user;
+
+    uint64_t seed;
+    vpds_allocator allocator;
+
+    uint64_t budget;            /* work units (darts + cells) per call before VPDS_PAUSED; 0: none */
+    vpds_progress_fn progress;  /* called between chunks of work; may pause */
+    void *progress_user;
+
+    uint32_t algorithm_version; /* 0: current (VPDS_ALGORITHM_VERSION); others are refused */
+} vpds_desc;
+
+/* Statistics of everything the sampler has done so far. */
+typedef struct vpds_stats {
+    uint64_t darts;            /* darts thrown */
+    uint64_t accepted;         /* darts that became samples */
+    uint32_t levels;           /* deepest level of the hyper-octree reached, plus one */
+    uint64_t peak_active_cells;
+    size_t bytes_held;         /* bytes currently allocated by the sampler */
+    size_t peak_bytes;         /* largest bytes_held seen */
+    uint64_t sizing_calls;     /* points at which r was evaluated */
+    double delta;              /* largest diagonal of a cell left active by the precision limit
+                                  (0: none); the set is then covered at t*coverage*f + delta */
+    double t;                  /* current scale */
+    int maximal;               /* non-zero when the last run completed */
+    uint64_t reserved[6];
+} vpds_stats;
+
+typedef struct vpds_sampler vpds_sampler;
+
+/* Defaults, cookie and size. */
+VPDS_API vpds_desc vpds_default_desc(void);
+/* Check a descriptor. Writes why it is refused (field and value) into msg (cap bytes). */
+VPDS_API vpds_status vpds_validate(const vpds_desc *desc, char *msg, size_t cap);
+VPDS_API vpds_status vpds_create(const vpds_desc *desc, vpds_sampler **out);
+VPDS_API void vpds_destroy(vpds_sampler *sampler);
+
+VPDS_API const char *vpds_status_string(vpds_status status);
+/* What exactly was wrong in the sampler's last failed call ("" if none). */
+VPDS_API const char *vpds_last_error(const vpds_sampler *sampler);
+VPDS_API const char *vpds_version_string(void);
+
+/* Sample until maximal at the current scale (1 for a new sampler). */
+VPDS_API vpds_status vpds_run(vpds_sampler *sampler);
+/* Discrete decrease (Section 4.3) to scale t < current, then maximal there. */
+VPDS_API vpds_status vpds_refine(vpds_sampler *sampler, double t);
+/* Continuous decrease (Section 4.2): one sample per call, t non-increasing. */
+VPDS_API vpds_status vpds_next(vpds_sampler *sampler, double t_min, double *x_out, double *t_out);
+/* Fixed points (objects already placed): n points of dim doubles; r NULL: the sizing decides. */
+VPDS_API vpds_status vpds_add_points(vpds_sampler *sampler, const double *x, const double *r,
+                                     size_t n);
+/* Change the work budget per call (0: none), e.g. per frame. */
+VPDS_API vpds_status vpds_set_budget(vpds_sampler *sampler, uint64_t budget);
+
+VPDS_API size_t vpds_count(const vpds_sampler *sampler);
+VPDS_API int vpds_dim(const vpds_sampler *sampler);
+/* count*dim doubles in insertion order; valid until the next call that changes the sampler. */
+VPDS_API const double *vpds_points(const vpds_sampler *sampler);
+/* r at each sample (unscaled). */
+VPDS_API const double *vpds_radii(const vpds_sampler *sampler);
+/* Scale t at which each sample was inserted (+INFINITY for fixed points). */
+VPDS_API const double *vpds_scales(const vpds_sampler *sampler);
+/* Per-sample flags: VPDS_FLAG_FIXED for a fixed point, VPDS_FLAG_OWN_RADIUS when its radius was
+ * given to vpds_add_points rather than read from the sizing. */
+#define VPDS_FLAG_FIXED 1u
+#define VPDS_FLAG_OWN_RADIUS 2u
+VPDS_API const uint8_t *vpds_flags(const vpds_sampler *sampler);
+VPDS_API vpds_stats vpds_get_stats(const vpds_sampler *sampler);
+
+/* ---- Grid sizing: values at the nodes of a regular grid over [lo, hi], multilinear between. */
+typedef struct vpds_grid_desc {
+    uint32_t cookie;
+    uint32_t struct_size;
+    int dim;
+    const size_t *shape;  /* nodes per axis (>= 2 each); values are C order, axis 0 slowest */
+    const double *values; /* prod(shape) radii > 0; copied */
+    const double *lo;     /* dim doubles (NULL: all 0) */
+    const double *hi;     /* dim doubles (NULL: all 1) */
+    vpds_allocator allocator;
+} vpds_grid_desc;
+
+VPDS_API vpds_grid_desc vpds_default_grid_desc(void);
+VPDS_API vpds_status vpds_grid_validate(const vpds_grid_desc *desc, char *msg, size_t cap);
+VPDS_API vpds_status vpds_grid_create(const vpds_grid_desc *desc, vpds_grid **out);
+VPDS_API void vpds_grid_destroy(vpds_grid *grid);
+/* Exact Lipschitz constant of the interpolant: its largest gradient norm (at cell corners). */
+VPDS_API double vpds_grid_lipschitz(const vpds_grid *grid);
+/* Lower values, as little as the sufficient condition "every edge slope <= L/sqrt(dim)"
+ * allows (the largest such function below the grid), so that the interpolant is L-Lipschitz. */
+VPDS_API vpds_status vpds_grid_enforce_lipschitz(vpds_grid *grid, double lipschitz);
+/* r at x (coordinates outside [lo, hi] are clamped). */
+VPDS_API double vpds_grid_eval(const vpds_grid *grid, const double *x);
+VPDS_API const double *vpds_grid_values(const vpds_grid *grid);
+VPDS_API size_t vpds_grid_size(const vpds_grid *grid);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* VPDS_H */

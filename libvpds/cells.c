@@ -1,0 +1,66 @@
+#include "cells.h"
+#include <string.h>
+
+unsigned vpdsi_bit_length(uint64_t n)
+{
+    unsigned b = 0;
+    if (n > 0) n -= 1;
+    while (n) {
+        b++;
+        n >>= 1;
+    }
+    return b ? b : 1;
+}
+
+void vpdsi_cells_layout(vpdsi_cells *c, int dim, const uint64_t *n0, unsigned level)
+{
+    unsigned k, off = 0;
+    for (k = 0; k < (unsigned)dim; k++) {
+        c->bits[k] = vpdsi_bit_length(n0[k]) + level;
+        c->offset[k] = off;
+        off += c->bits[k];
+    }
+    c->words_per_cell = (off + 63) / 64;
+    c->level = level;
+    c->count = 0;
+}
+
+int vpdsi_cells_reserve(vpdsi_cells *c, vpdsi_mem *m, size_t cells)
+{
+    size_t words;
+    if (vpdsi_mul_size(cells, c->words_per_cell, &words)) return -1;
+    return vpdsi_mem_reserve(m, (void **)&c->words, &c->cap_words, words, sizeof *c->words);
+}
+
+void vpdsi_cells_release(vpdsi_cells *c, vpdsi_mem *m)
+{
+    vpdsi_mem_free(m, c->words, c->cap_words * sizeof *c->words);
+    c->words = NULL;
+    c->cap_words = 0;
+    c->count = 0;
+}
+
+void vpdsi_cells_push(vpdsi_cells *c, int dim, const uint64_t *coord)
+{
+    uint64_t *w = c->words + c->count * c->words_per_cell;
+    unsigned k;
+    memset(w, 0, c->words_per_cell * sizeof *w);
+    for (k = 0; k < (unsigned)dim; k++) {
+        unsigned off = c->offset[k], wi = off >> 6, sh = off & 63u;
+        w[wi] |= coord[k] << sh;
+        if (sh && sh + c->bits[k] > 64) w[wi + 1] |= coord[k] >> (64 - sh);
+    }
+    c->count++;
+}
+
+void vpdsi_cells_get(const vpdsi_cells *c, size_t i, int dim, uint64_t *coord)
+{
+    const uint64_t *w = c->words + i * c->words_per_cell;
+    unsigned k;
+    for (k = 0; k < (unsigned)dim; k++) {
+        unsigned off = c->offset[k], wi = off >> 6, sh = off & 63u, b = c->bits[k];
+        uint64_t v = w[wi] >> sh;
+        if (sh && sh + b > 64) v |= w[wi + 1] << (64 - sh);
+        coord[k] = b >= 64 ? v : (v & ((1ull << b) - 1));
+    }
+}

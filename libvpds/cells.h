@@ -1,0 +1,25 @@
+/* The flat hyper-octree of Algorithm 1: the active cells of one level, all the same size, stored
+ * as integer coordinates bit-packed into 64-bit words (covered cells cost nothing). */
+#ifndef VPDS_CELLS_H
+#define VPDS_CELLS_H
+#include "mem.h"
+
+typedef struct vpdsi_cells {
+    uint64_t *words;
+    size_t cap_words;
+    size_t count;        /* cells held */
+    unsigned level;
+    unsigned words_per_cell;
+    unsigned bits[VPDS_MAX_DIM], offset[VPDS_MAX_DIM];
+} vpdsi_cells;
+
+/* Empty the array and lay it out for `level` over a base grid of n0[k] cells per axis. */
+void vpdsi_cells_layout(vpdsi_cells *c, int dim, const uint64_t *n0, unsigned level);
+int vpdsi_cells_reserve(vpdsi_cells *c, vpdsi_mem *m, size_t cells);
+void vpdsi_cells_release(vpdsi_cells *c, vpdsi_mem *m);
+/* Append (after reserve; never allocates) and read back. */
+void vpdsi_cells_push(vpdsi_cells *c, int dim, const uint64_t *coord);
+void vpdsi_cells_get(const vpdsi_cells *c, size_t i, int dim, uint64_t *coord);
+/* Bits needed to hold values below n (at least 1). */
+unsigned vpdsi_bit_length(uint64_t n);
+#endif

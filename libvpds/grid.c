@@ -1,0 +1,249 @@
+/* Built-in sizing: a regular grid with multilinear interpolation, its exact Lipschitz constant,
+ * and the Lipschitz envelope ("smoothed for L", Section 7 / Figure 12). */
+#include "grid.h"
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+vpds_grid_desc vpds_default_grid_desc(void)
+{
+    vpds_grid_desc d;
+    memset(&d, 0, sizeof d);
+    d.cookie = VPDSI_GRID_COOKIE;
+    d.struct_size = (uint32_t)sizeof d;
+    d.dim = 2;
+    return d;
+}
+
+#define FAIL(st, ...) do { if (msg && cap) snprintf(msg, cap, __VA_ARGS__); return st; } while (0)
+
+vpds_status vpds_grid_validate(const vpds_grid_desc *d, char *msg, size_t cap)
+{
+    size_t n = 1, k, i;
+    if (msg && cap) msg[0] = 0;
+    if (!d) FAIL(VPDS_ERR_INVALID_ARGUMENT, "desc is NULL");
+    if (d->cookie != VPDSI_GRID_COOKIE)
+        FAIL(VPDS_ERR_BAD_DESCRIPTOR, "grid desc: cookie 0x%08x is not from vpds_default_grid_desc()",
+             (unsigned)d->cookie);
+    if (d->struct_size != sizeof *d)
+        FAIL(VPDS_ERR_BAD_DESCRIPTOR, "grid desc: struct_size %u, this library reads %u",
+             (unsigned)d->struct_size, (unsigned)sizeof *d);
+    if (d->dim < 1 || d->dim > VPDS_MAX_DIM)
+        FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: dim = %d, must be in 1..%d", d->dim, VPDS_MAX_DIM);
+    if (!d->shape) FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: shape is NULL");
+    if (!d->values) FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: values is NULL");
+    if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
+        FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: allocator.alloc and allocator.free must both be set or both NULL");
+    for (k = 0; k < (size_t)d->dim; k++) {
+        double lo = d->lo ? d->lo[k] : 0.0, hi = d->hi ? d->hi[k] : 1.0;
+        if (d->shape[k] < 2)
+            FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: shape[%u] = %zu, need at least 2 nodes per axis",
+                 (unsigned)k, d->shape[k]);
+        if (vpdsi_mul_size(n, d->shape[k], &n) != 0 || n > ((size_t)-1) / (2 * sizeof(double)))
+            FAIL(VPDS_ERR_OVERFLOW, "grid desc: the node count overflows at shape[%u] = %zu",
+                 (unsigned)k, d->shape[k]);
+        if (!isfinite(lo) || !isfinite(hi) || !(lo < hi))
+            FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: axis %u has lo = %g, hi = %g; need finite lo < hi",
+                 (unsigned)k, lo, hi);
+    }
+    for (i = 0; i < n; i++)
+        if (!isfinite(d->values[i]) || !(d->values[i] > 0))
+            FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: values[%zu] = %g; radii must be finite and > 0",
+                 i, d->values[i]);
+    return VPDS_OK;
+}
+
+/* Largest gradient norm of the interpolant. Along any axis-parallel line in a cell the squared
+ * gradient norm is a convex quadratic, so its maximum is at a corner, where each component is
+ * the slope of the cell edge leaving that corner along its axis. */
+static double grid_exact_lipschitz(const vpds_grid *g)
+{
+    size_t cell[VPDS_MAX_DIM] = {0};
+    unsigned d = (unsigned)g->dim, corners = 1u << d, c, k;
+    double best = 0;
+    for (;;) {
+        size_t base = 0;
+        for (k = 0; k < d; k++) base += cell[k] * g->stride[k];
+        for (c = 0; c < corners; c++) {
+            double s2 = 0;
+            for (k = 0; k < d; k++) {
+                size_t i0 = base, i1;
+                unsigned j;
+                for (j = 0; j < d; j++)
+                    if (j != k && (c >> j & 1u)) i0 += g->stride[j];
+                i1 = i0 + g->stride[k];
+                {
+                    double slope = (g->values[i1] - g->values[i0]) / g->step[k];
+                    s2 += slope * slope;
+                }
+            }
+            if (s2 > best) best = s2;
+        }
+        for (k = 0; k < d; k++) {
+            if (++cell[k] < g->shape[k] - 1) break;
+            cell[k] = 0;
+        }
+        if (k == d) break;
+    }
+    return sqrt(best);
+}
+
+static void grid_refresh(vpds_grid *g)
+{
+    size_t i;
+    g->vmin = g->vmax = g->values[0];
+    for (i = 1; i < g->n; i++) {
+        if (g->values[i] < g->vmin) g->vmin = g->values[i];
+        if (g->values[i] > g->vmax) g->vmax = g->values[i];
+    }
+    g->lipschitz = grid_exact_lipschitz(g);
+}
+
+vpds_status vpds_grid_create(const vpds_grid_desc *d, vpds_grid **out)
+{
+    vpdsi_mem m;
+    vpds_grid *g;
+    size_t k, s;
+    vpds_status st;
+    if (!out) return VPDS_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    st = vpds_grid_validate(d, NULL, 0);
+    if (st != VPDS_OK) return st;
+    vpdsi_mem_init(&m, &d->allocator);
+    g = (vpds_grid *)vpdsi_mem_alloc(&m, sizeof *g);
+    if (!g) return VPDS_ERR_OUT_OF_MEMORY;
+    memset(g, 0, sizeof *g);
+    g->magic = VPDSI_GRID_COOKIE;
+    g->dim = d->dim;
+    g->n = 1;
+    for (k = 0; k < (size_t)d->dim; k++) {
+        g->shape[k] = d->shape[k];
+        g->n *= d->shape[k];
+        g->lo[k] = d->lo ? d->lo[k] : 0.0;
+        g->hi[k] = d->hi ? d->hi[k] : 1.0;
+        g->step[k] = (g->hi[k] - g->lo[k]) / (double)(d->shape[k] - 1);
+    }
+    for (s = 1, k = (size_t)d->dim; k-- > 0;) {
+        g->stride[k] = s;
+        s *= g->shape[k];
+    }
+    g->values = (double *)vpdsi_mem_alloc(&m, g->n * sizeof(double));
+    if (!g->values) {
+        vpdsi_mem_free(&m, g, sizeof *g);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    memcpy(g->values, d->values, g->n * sizeof(double));
+    g->mem = m;
+    grid_refresh(g);
+    *out = g;
+    return VPDS_OK;
+}
+
+vpds_status vpdsi_grid_clone(const vpds_grid *src, const vpds_allocator *a, vpds_grid **out)
+{
+    vpdsi_mem m;
+    vpds_grid *g;
+    vpdsi_mem_init(&m, a);
+    g = (vpds_grid *)vpdsi_mem_alloc(&m, sizeof *g);
+    if (!g) return VPDS_ERR_OUT_OF_MEMORY;
+    *g = *src;
+    g->values = (double *)vpdsi_mem_alloc(&m, src->n * sizeof(double));
+    if (!g->values) {
+        vpdsi_mem_free(&m, g, sizeof *g);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    memcpy(g->values, src->values, src->n * sizeof(double));
+    g->mem = m;
+    *out = g;
+    return VPDS_OK;
+}
+
+void vpds_grid_destroy(vpds_grid *g)
+{
+    vpdsi_mem m;
+    if (!g || g->magic != VPDSI_GRID_COOKIE) return;
+    m = g->mem;
+    vpdsi_mem_free(&m, g->values, g->n * sizeof(double));
+    g->magic = 0;
+    vpdsi_mem_free(&m, g, sizeof *g);
+}
+
+double vpds_grid_lipschitz(const vpds_grid *g)
+{
+    return (g && g->magic == VPDSI_GRID_COOKIE) ? g->lipschitz : NAN;
+}
+
+const double *vpds_grid_values(const vpds_grid *g)
+{
+    return (g && g->magic == VPDSI_GRID_COOKIE) ? g->values : NULL;
+}
+
+size_t vpds_grid_size(const vpds_grid *g)
+{
+    return (g && g->magic == VPDSI_GRID_COOKIE) ? g->n : 0;
+}
+
+double vpds_grid_eval(const vpds_grid *g, const double *x)
+{
+    size_t base = 0, k;
+    double frac[VPDS_MAX_DIM], sum = 0;
+    unsigned c, d, corners;
+    if (!g || g->magic != VPDSI_GRID_COOKIE || !x) return NAN;
+    d = (unsigned)g->dim;
+    for (k = 0; k < d; k++) {
+        double u = (x[k] - g->lo[k]) / g->step[k], fl;
+        size_t i;
+        if (!(u > 0)) u = 0; /* also maps NaN to the first node */
+        if (u > (double)(g->shape[k] - 1)) u = (double)(g->shape[k] - 1);
+        fl = floor(u);
+        i = (size_t)fl;
+        if (i > g->shape[k] - 2) i = g->shape[k] - 2;
+        frac[k] = u - (double)i;
+        base += i * g->stride[k];
+    }
+    corners = 1u << d;
+    for (c = 0; c < corners; c++) {
+        double w = 1;
+        size_t idx = base;
+        for (k = 0; k < d; k++) {
+            if (c >> k & 1u) {
+                w *= frac[k];
+                idx += g->stride[k];
+            } else {
+                w *= 1 - frac[k];
+            }
+        }
+        sum += w * g->values[idx];
+    }
+    return sum;
+}
+
+/* The largest grid below the values whose every edge slope is at most L/sqrt(d): a weighted
+ * l1 distance transform, done exactly by a forward and a backward sweep along each axis. Its
+ * interpolant then has corner gradients of norm <= sqrt(d * (L/sqrt(d))^2) = L. The price of
+ * this sufficient condition: slopes along an axis are held to L/sqrt(d), not L. */
+vpds_status vpds_grid_enforce_lipschitz(vpds_grid *g, double L)
+{
+    size_t k, d;
+    if (!g || g->magic != VPDSI_GRID_COOKIE) return VPDS_ERR_INVALID_ARGUMENT;
+    if (!isfinite(L) || !(L > 0)) return VPDS_ERR_INVALID_ARGUMENT;
+    d = (size_t)g->dim;
+    for (k = 0; k < d; k++) {
+        double c = L * g->step[k] / sqrt((double)d);
+        size_t len = g->shape[k], st = g->stride[k], line, lines = g->n / len;
+        for (line = 0; line < lines; line++) {
+            /* start index of the line-th line along axis k */
+            size_t outer = line / st, inner = line % st, start = outer * st * len + inner, i;
+            for (i = 1; i < len; i++) {
+                double *v = &g->values[start + i * st], prev = g->values[start + (i - 1) * st] + c;
+                if (prev < *v) *v = prev;
+            }
+            for (i = len - 1; i-- > 0;) {
+                double *v = &g->values[start + i * st], next = g->values[start + (i + 1) * st] + c;
+                if (next < *v) *v = next;
+            }
+        }
+    }
+    grid_refresh(g);
+    return VPDS_OK;
+}

@@ -1,0 +1,23 @@
+/* Private layout of vpds_grid, shared with the sizing evaluator. */
+#ifndef VPDS_GRID_H
+#define VPDS_GRID_H
+#include "mem.h"
+
+#define VPDSI_GRID_COOKIE 0x56504447u /* 'VPDG' */
+
+struct vpds_grid {
+    uint32_t magic;
+    int dim;
+    size_t shape[VPDS_MAX_DIM];
+    size_t stride[VPDS_MAX_DIM];
+    size_t n;
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], step[VPDS_MAX_DIM];
+    double *values;
+    double lipschitz; /* exact, recomputed after every change */
+    double vmin, vmax;
+    vpdsi_mem mem;
+};
+
+/* A copy of g made with the allocator m (used by the sampler, which owns its copy). */
+vpds_status vpdsi_grid_clone(const vpds_grid *g, const vpds_allocator *a, vpds_grid **out);
+#endif

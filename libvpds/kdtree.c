@@ -1,0 +1,284 @@
+#include "kdtree.h"
+#include "rules.h"
+#include <math.h>
+#include <string.h>
+
+#define BOX_LO(t, n) ((t)->box + (size_t)(n) * 2 * (size_t)(t)->dim)
+#define BOX_HI(t, n) (BOX_LO(t, n) + (t)->dim)
+#define STACK_MAX (VPDSI_KD_MAX_DEPTH + 8)
+
+void vpdsi_kd_init(vpdsi_kdtree *t, int dim)
+{
+    memset(t, 0, sizeof *t);
+    t->dim = dim;
+}
+
+void vpdsi_kd_release(vpdsi_kdtree *t, vpdsi_mem *m)
+{
+    vpdsi_mem_free(m, t->nodes, t->cap_nodes * sizeof *t->nodes);
+    vpdsi_mem_free(m, t->box, t->cap_box * sizeof *t->box);
+    vpdsi_mem_free(m, t->next, t->cap_next * sizeof *t->next);
+    vpdsi_kd_init(t, t->dim);
+}
+
+size_t vpdsi_kd_bytes(const vpdsi_kdtree *t)
+{
+    return t->cap_nodes * sizeof *t->nodes + t->cap_box * sizeof *t->box +
+           t->cap_next * sizeof *t->next;
+}
+
+int vpdsi_kd_reserve(vpdsi_kdtree *t, vpdsi_mem *m, size_t n_total, size_t more)
+{
+    size_t nodes = t->n_nodes + 2 * more + 1, boxes;
+    if (vpdsi_mul_size(nodes, 2 * (size_t)t->dim, &boxes) != 0) return -1;
+    if (vpdsi_mem_reserve(m, (void **)&t->next, &t->cap_next, n_total, sizeof *t->next)) return -1;
+    if (vpdsi_mem_reserve(m, (void **)&t->nodes, &t->cap_nodes, nodes, sizeof *t->nodes)) return -1;
+    {
+        /* keep the box array in step with the node array's capacity */
+        size_t want = t->cap_nodes * 2 * (size_t)t->dim;
+        if (vpdsi_mem_reserve(m, (void **)&t->box, &t->cap_box, want, sizeof *t->box)) return -1;
+    }
+    return 0;
+}
+
+static void leaf_init(vpdsi_kdtree *t, int32_t n)
+{
+    vpdsi_kd_node *nd = &t->nodes[n];
+    nd->left = nd->right = -1;
+    nd->head = -1;
+    nd->count = 0;
+    nd->split = 0;
+    nd->rmax = 0;
+    nd->axis = 0;
+    nd->pad = 0;
+}
+
+static void node_add(vpdsi_kdtree *t, int32_t n, const double *p, double r, int empty)
+{
+    double *lo = BOX_LO(t, n), *hi = BOX_HI(t, n);
+    int k;
+    for (k = 0; k < t->dim; k++) {
+        if (empty || p[k] < lo[k]) lo[k] = p[k];
+        if (empty || p[k] > hi[k]) hi[k] = p[k];
+    }
+    if (empty || r > t->nodes[n].rmax) t->nodes[n].rmax = r;
+}
+
+/* Split a full leaf at the mean of its samples along its widest axis (a value strictly inside
+ * the box's extent, so both sides get samples). Leaves of identical points stay whole. */
+static void leaf_split(vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t n)
+{
+    const double *lo = BOX_LO(t, n), *hi = BOX_HI(t, n);
+    int k, axis = 0, d = t->dim;
+    double best = -1, sum = 0, split;
+    int32_t i, next, children[2];
+    vpdsi_kd_node *nd;
+    for (k = 0; k < d; k++)
+        if (hi[k] - lo[k] > best) {
+            best = hi[k] - lo[k];
+            axis = k;
+        }
+    if (!(best > 0)) return;
+    for (i = t->nodes[n].head; i >= 0; i = t->next[i]) sum += s->x[(size_t)i * d + axis];
+    split = sum / t->nodes[n].count;
+    if (!(split > lo[axis]) || split > hi[axis]) split = hi[axis];
+    children[0] = (int32_t)t->n_nodes;
+    children[1] = (int32_t)t->n_nodes + 1;
+    t->n_nodes += 2;
+    leaf_init(t, children[0]);
+    leaf_init(t, children[1]);
+    nd = &t->nodes[n];
+    for (i = nd->head; i >= 0; i = next) {
+        const double *p = s->x + (size_t)i * d;
+        int32_t c = children[p[axis] < split ? 0 : 1];
+        next = t->next[i];
+        node_add(t, c, p, s->r[i], t->nodes[c].count == 0);
+        t->next[i] = t->nodes[c].head;
+        t->nodes[c].head = i;
+        t->nodes[c].count++;
+    }
+    nd->left = children[0];
+    nd->right = children[1];
+    nd->axis = axis;
+    nd->split = split;
+    nd->head = -1;
+    nd->count = 0;
+}
+
+void vpdsi_kd_insert(vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i)
+{
+    const double *p = s->x + (size_t)i * t->dim;
+    double r = s->r[i];
+    int32_t n = 0;
+    int depth = 0;
+    if (t->n_nodes == 0) {
+        t->n_nodes = 1;
+        leaf_init(t, 0);
+        node_add(t, 0, p, r, 1);
+    } else {
+        node_add(t, 0, p, r, 0);
+    }
+    while (t->nodes[n].left >= 0) {
+        vpdsi_kd_node *nd = &t->nodes[n];
+        n = p[nd->axis] < nd->split ? nd->left : nd->right;
+        depth++;
+        node_add(t, n, p, r, 0);
+    }
+    t->next[i] = t->nodes[n].head;
+    t->nodes[n].head = i;
+    t->nodes[n].count++;
+    if (depth > t->depth) t->depth = depth;
+    if (t->nodes[n].count > VPDSI_KD_LEAF && depth < VPDSI_KD_MAX_DEPTH) {
+        leaf_split(t, s, n);
+        if (t->nodes[n].left >= 0 && depth + 1 > t->depth) t->depth = depth + 1;
+    }
+}
+
+double vpdsi_box_mindist2(const double *p, const double *lo, const double *hi, int dim)
+{
+    double s = 0;
+    int k;
+    for (k = 0; k < dim; k++) {
+        double e = 0;
+        if (p[k] < lo[k]) e = lo[k] - p[k];
+        else if (p[k] > hi[k]) e = p[k] - hi[k];
+        s += e * e;
+    }
+    return s;
+}
+
+double vpdsi_box_maxdist2(const double *p, const double *lo, const double *hi, int dim)
+{
+    double s = 0;
+    int k;
+    for (k = 0; k < dim; k++) {
+        double a = p[k] - lo[k], b = hi[k] - p[k], e = a > b ? a : b;
+        s += e * e;
+    }
+    return s;
+}
+
+static double box_box_mindist2(const double *alo, const double *ahi, const double *blo,
+                               const double *bhi, int dim)
+{
+    double s = 0;
+    int k;
+    for (k = 0; k < dim; k++) {
+        double e = 0;
+        if (ahi[k] < blo[k]) e = blo[k] - ahi[k];
+        else if (bhi[k] < alo[k]) e = alo[k] - bhi[k];
+        s += e * e;
+    }
+    return s;
+}
+
+static double dist2(const double *a, const double *b, int dim)
+{
+    double s = 0;
+    int k;
+    for (k = 0; k < dim; k++) {
+        double e = a[k] - b[k];
+        s += e * e;
+    }
+    return s;
+}
+
+int32_t vpdsi_kd_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *y,
+                          double ry, int rule, double scale, double lipschitz, int32_t *witness)
+{
+    int32_t stack[STACK_MAX];
+    int top = 0, d = t->dim;
+    if (t->n_nodes == 0) return -1;
+    stack[top++] = 0;
+    while (top > 0) {
+        int32_t n = stack[--top];
+        const vpdsi_kd_node *nd = &t->nodes[n];
+        double reach = scale * vpdsi_rule_f((vpds_rule)rule, nd->rmax, ry);
+        if (vpdsi_box_mindist2(y, BOX_LO(t, n), BOX_HI(t, n), d) >= reach * reach) continue;
+        if (nd->left < 0) {
+            int32_t i;
+            for (i = nd->head; i >= 0; i = t->next[i]) {
+                double d2 = dist2(y, s->x + (size_t)i * d, d);
+                double f = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], ry);
+                if (lipschitz >= 0 && !(s->flags[i] & VPDSI_SAMPLE_OWN_RADIUS)) {
+                    double gap = fabs(ry - s->r[i]);
+                    double allowed = lipschitz * sqrt(d2) * (1 + 1e-9) + 1e-12 * (ry + s->r[i]);
+                    if (gap > allowed) {
+                        *witness = i;
+                        return -2;
+                    }
+                }
+                if (d2 < f * f) return i;
+            }
+        } else {
+            int near = y[nd->axis] < nd->split;
+            stack[top++] = near ? nd->right : nd->left;
+            stack[top++] = near ? nd->left : nd->right;
+        }
+    }
+    return -1;
+}
+
+static int push_index(vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap, int32_t i)
+{
+    if (*count == *cap && vpdsi_mem_reserve(m, (void **)out, cap, *count + 1, sizeof **out))
+        return -1;
+    (*out)[(*count)++] = i;
+    return 0;
+}
+
+int vpdsi_kd_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *lo,
+                    const double *hi, double r_hi, int rule, double scale, double min_reach,
+                    vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap)
+{
+    int32_t stack[STACK_MAX];
+    int top = 0, d = t->dim;
+    if (t->n_nodes == 0) return 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        int32_t n = stack[--top];
+        const vpdsi_kd_node *nd = &t->nodes[n];
+        double reach = scale * vpdsi_rule_f((vpds_rule)rule, nd->rmax, r_hi);
+        if (reach < min_reach) continue;
+        if (box_box_mindist2(lo, hi, BOX_LO(t, n), BOX_HI(t, n), d) > reach * reach) continue;
+        if (nd->left < 0) {
+            int32_t i;
+            for (i = nd->head; i >= 0; i = t->next[i]) {
+                double f = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_hi);
+                if (f < min_reach) continue;
+                if (vpdsi_box_mindist2(s->x + (size_t)i * d, lo, hi, d) > f * f) continue;
+                if (push_index(m, out, count, cap, i)) return -1;
+            }
+        } else {
+            stack[top++] = nd->left;
+            stack[top++] = nd->right;
+        }
+    }
+    return 0;
+}
+
+int vpdsi_kd_radius(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *p,
+                    double radius, vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap)
+{
+    int32_t stack[STACK_MAX];
+    int top = 0, d = t->dim;
+    double r2 = radius * radius;
+    if (t->n_nodes == 0) return 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        int32_t n = stack[--top];
+        const vpdsi_kd_node *nd = &t->nodes[n];
+        if (vpdsi_box_mindist2(p, BOX_LO(t, n), BOX_HI(t, n), d) > r2) continue;
+        if (nd->left < 0) {
+            int32_t i;
+            for (i = nd->head; i >= 0; i = t->next[i])
+                if (dist2(p, s->x + (size_t)i * d, d) <= r2 &&
+                    push_index(m, out, count, cap, i))
+                    return -1;
+        } else {
+            stack[top++] = nd->left;
+            stack[top++] = nd->right;
+        }
+    }
+    return 0;
+}

@@ -1,0 +1,75 @@
+/* Incremental bucket kd-tree of samples (Section 6) with the proximity primitives of Table 2.
+ *
+ * Each node keeps the bounding box of its samples and the largest radius among them. A branch
+ * is pruned when no sample in it can reach the query even with that largest radius: a stored
+ * bound, so pruning calls no sizing function (Table 2 evaluates r at the projection p_perp
+ * instead) and stays valid for fixed points whose radii do not follow the sizing. */
+#ifndef VPDS_KDTREE_H
+#define VPDS_KDTREE_H
+#include "mem.h"
+
+#define VPDSI_KD_LEAF 8        /* samples per leaf before it splits */
+#define VPDSI_KD_MAX_DEPTH 480 /* deeper leaves stop splitting: slower, never wrong */
+
+/* Per-sample flags. */
+#define VPDSI_SAMPLE_FIXED 1u      /* added by vpds_add_points */
+#define VPDSI_SAMPLE_OWN_RADIUS 2u /* its radius was given, not read from the sizing */
+
+typedef struct vpdsi_kd_node {
+    int32_t left, right;  /* left < 0: a leaf */
+    int32_t head, count;  /* leaf: first sample of its list (next[]), and how many */
+    double split;
+    double rmax;
+    int32_t axis;
+    int32_t pad;
+} vpdsi_kd_node;
+
+typedef struct vpdsi_kdtree {
+    int dim;
+    vpdsi_kd_node *nodes;
+    size_t n_nodes, cap_nodes;
+    double *box; /* per node: dim lows then dim highs */
+    size_t cap_box;
+    int32_t *next; /* per sample: next sample in the same leaf, -1 at the end */
+    size_t cap_next;
+    int depth;
+} vpdsi_kdtree;
+
+/* The samples the tree indexes (owned by the sampler, which may move them). */
+typedef struct vpdsi_kd_samples {
+    const double *x;   /* n * dim */
+    const double *r;   /* n */
+    const uint8_t *flags;
+} vpdsi_kd_samples;
+
+void vpdsi_kd_init(vpdsi_kdtree *t, int dim);
+void vpdsi_kd_release(vpdsi_kdtree *t, vpdsi_mem *m);
+/* Room to insert up to `more` samples, the tree then holding `n_total` samples. */
+int vpdsi_kd_reserve(vpdsi_kdtree *t, vpdsi_mem *m, size_t n_total, size_t more);
+/* Insert sample i (after vpdsi_kd_reserve). Never allocates. */
+void vpdsi_kd_insert(vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i);
+size_t vpdsi_kd_bytes(const vpdsi_kdtree *t);
+
+/* Conflict: the first sample x (in search order) with |y - x| < scale * f(r(x), ry), or -1.
+ * f is the rule (ry unused for prior). Covers PiX (prior), XiP (current), and their "or"
+ * (bigger) and "and" (smaller), Table 2. When lipschitz >= 0 every sample met whose radius
+ * follows the sizing is checked against |r(x) - ry| <= L |x - y|; a break returns -2 and its
+ * index in *witness. */
+int32_t vpdsi_kd_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *y,
+                          double ry, int rule, double scale, double lipschitz, int32_t *witness);
+
+/* Samples that might cover a whole sub-box of reach at least min_reach inside the box
+ * [lo, hi]: |x - box| <= scale * f(r(x), r_hi) and scale * f(r(x), r_hi) >= min_reach, where r_hi
+ * bounds r over the box from above. Appends indices to *out (grown with m); -1 on OOM. */
+int vpdsi_kd_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *lo,
+                    const double *hi, double r_hi, int rule, double scale, double min_reach,
+                    vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap);
+
+/* All samples with |x - p| <= radius, appended to *out; -1 on OOM. */
+int vpdsi_kd_radius(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *p,
+                    double radius, vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap);
+
+/* Squared distances between a point and a box: nearest and farthest point of the box. */
+double vpdsi_box_mindist2(const double *p, const double *lo, const double *hi, int dim);
+double vpdsi_box_maxdist2(const double *p, const double *lo, const double *hi, int dim);
+#endif

@@ -1,0 +1,82 @@
+/* The allocator interface: every byte the library holds goes through here. */
+#include "mem.h"
+#include <stdlib.h>
+#include <string.h>
+
+static void *default_alloc(size_t size, void *user) { (void)user; return malloc(size); }
+static void *default_realloc(void *p, size_t old_size, size_t new_size, void *user)
+{
+    (void)old_size; (void)user;
+    return realloc(p, new_size);
+}
+static void default_free(void *p, size_t size, void *user) { (void)size; (void)user; free(p); }
+
+void vpdsi_mem_init(vpdsi_mem *m, const vpds_allocator *a)
+{
+    memset(m, 0, sizeof *m);
+    if (a && a->alloc) {
+        m->a = *a;
+    } else {
+        m->a.alloc = default_alloc;
+        m->a.realloc = default_realloc;
+        m->a.free = default_free;
+        m->a.user = NULL;
+    }
+}
+
+void *vpdsi_mem_alloc(vpdsi_mem *m, size_t size)
+{
+    void *p;
+    if (size == 0) size = 1;
+    p = m->a.alloc(size, m->a.user);
+    if (p) {
+        m->held += size;
+        if (m->held > m->peak) m->peak = m->held;
+    }
+    return p;
+}
+
+void vpdsi_mem_free(vpdsi_mem *m, void *p, size_t size)
+{
+    if (!p) return;
+    if (size == 0) size = 1;
+    m->a.free(p, size, m->a.user);
+    m->held -= size;
+}
+
+int vpdsi_mul_size(size_t a, size_t b, size_t *out)
+{
+    if (a != 0 && b > (size_t)-1 / a) return -1;
+    *out = a * b;
+    return 0;
+}
+
+int vpdsi_mem_reserve(vpdsi_mem *m, void **p, size_t *cap, size_t need, size_t elem)
+{
+    size_t new_cap, old_bytes, new_bytes;
+    void *q;
+    if (need <= *cap) return 0;
+    new_cap = *cap + *cap / 2 + 16;
+    if (new_cap < *cap || new_cap < need) new_cap = need;
+    if (vpdsi_mul_size(new_cap, elem, &new_bytes) != 0) {
+        new_cap = need;
+        if (vpdsi_mul_size(new_cap, elem, &new_bytes) != 0) return -1;
+    }
+    old_bytes = *cap * elem;
+    if (*p && m->a.realloc) {
+        q = m->a.realloc(*p, old_bytes, new_bytes, m->a.user);
+        if (!q) return -1;
+        m->held += new_bytes - old_bytes;
+        if (m->held > m->peak) m->peak = m->held;
+    } else {
+        q = vpdsi_mem_alloc(m, new_bytes);
+        if (!q) return -1;
+        if (*p) {
+            memcpy(q, *p, old_bytes);
+            vpdsi_mem_free(m, *p, old_bytes);
+        }
+    }
+    *p = q;
+    *cap = new_cap;
+    return 0;
+}

@@ -1,0 +1,21 @@
+/* Memory through the caller's allocator, with the bytes held counted for vpds_stats. */
+#ifndef VPDS_MEM_H
+#define VPDS_MEM_H
+#include "vpds.h"
+
+typedef struct vpdsi_mem {
+    vpds_allocator a;
+    size_t held;
+    size_t peak;
+} vpdsi_mem;
+
+/* Fill a from the user's allocator (both NULL: malloc/free). */
+void vpdsi_mem_init(vpdsi_mem *m, const vpds_allocator *a);
+void *vpdsi_mem_alloc(vpdsi_mem *m, size_t size);
+void vpdsi_mem_free(vpdsi_mem *m, void *p, size_t size);
+/* Make *cap >= need elements of size elem, growing by about 1.5x. Returns 0, or -1 when the
+ * size overflows or the allocator fails (then *p and *cap are unchanged). */
+int vpdsi_mem_reserve(vpdsi_mem *m, void **p, size_t *cap, size_t need, size_t elem);
+/* a*b without overflow: returns 0 and writes *out, or -1. */
+int vpdsi_mul_size(size_t a, size_t b, size_t *out);
+#endif

@@ -1,0 +1,384 @@
+/* Algorithm 1 (Section 3.1): darts thrown into a flat hyper-octree of active cells, then a
+ * coverage sweep that splits every active cell into 2^d children and keeps the uncovered ones.
+ *
+ * Bias-free (Eq. 4): a dart picks an active cell uniformly (all cells of a level have the same
+ * size) and a point uniformly in it; it becomes a sample iff it conflicts with no sample. The
+ * active cells always contain every uncovered point, so accepted darts are uniform over the free
+ * region. Work is cut into chunks; between chunks the state is complete, so a pause, an error
+ * or an exhausted budget can resume to exactly the points of an uninterrupted run. */
+#include "sampler.h"
+#include "rules.h"
+#include <math.h>
+#include <string.h>
+
+#define DARTS_PER_CELL 0.5  /* A of Algorithm 1 */
+#define CHUNK 256           /* darts or cells between checks of the budget */
+#define PRECISION_BITS 44   /* cells stop splitting at 2^-44 of the coordinates' magnitude */
+
+void vpdsi_mps_reset(vpds_sampler *s, double t)
+{
+    s->run.phase = VPDSI_IDLE;
+    s->run.t = t;
+    s->stats.t = t;
+    s->stats.maximal = 0;
+}
+
+void vpdsi_mps_release(vpds_sampler *s)
+{
+    vpdsi_cells_release(&s->run.cur, &s->mem);
+    vpdsi_cells_release(&s->run.next, &s->mem);
+}
+
+static uint64_t darts_for(uint64_t cells)
+{
+    double n = ceil(DARTS_PER_CELL * (double)cells);
+    return n < 1 ? 1 : (uint64_t)n;
+}
+
+/* Base grid for the current scale: cells of diagonal t*coverage*r_max, so that in the uniform
+ * case a sample covers its whole cell. */
+static vpds_status setup(vpds_sampler *s)
+{
+    vpdsi_run *run = &s->run;
+    int d = s->dim, k;
+    double target = run->t * s->coverage * s->sizing.rmax / sqrt((double)d) * (1 - 1e-9);
+    uint64_t total = 1;
+    unsigned max_level = 62;
+    for (k = 0; k < d; k++) {
+        double ext = s->hi[k] - s->lo[k], cells = ceil(ext / target), mag, min_side;
+        unsigned lev;
+        if (!(cells <= 1099511627776.0)) { /* 2^40 per axis */
+            vpdsi_set_error(s, "scale t = %g: axis %d of extent %g needs %g base cells of side %g;"
+                            " the cell count overflows", run->t, k, ext, cells, target);
+            return VPDS_ERR_OVERFLOW;
+        }
+        run->n0[k] = cells < 1 ? 1 : (uint64_t)cells;
+        run->side0[k] = ext / (double)run->n0[k];
+        if (total > (UINT64_C(1) << 62) / run->n0[k]) {
+            vpdsi_set_error(s, "scale t = %g: the base grid has more than 2^62 cells (radius too"
+                            " small for the box)", run->t);
+            return VPDS_ERR_OVERFLOW;
+        }
+        total *= run->n0[k];
+        mag = fabs(s->lo[k]) > fabs(s->hi[k]) ? fabs(s->lo[k]) : fabs(s->hi[k]);
+        if (ext > mag) mag = ext;
+        min_side = ldexp(mag, -PRECISION_BITS);
+        lev = 0;
+        while (lev < 62 && ldexp(run->side0[k], -(int)(lev + 1)) >= min_side) lev++;
+        if (lev + vpdsi_bit_length(run->n0[k]) > 63) lev = 63 - vpdsi_bit_length(run->n0[k]);
+        if (lev < max_level) max_level = lev;
+    }
+    run->base_count = total;
+    run->max_level = max_level;
+    run->implicit = 1;
+    run->pos = 0;
+    vpdsi_cells_layout(&run->cur, d, run->n0, 0);
+    vpdsi_cells_layout(&run->next, d, run->n0, 0);
+    if (s->n > 0) {
+        run->phase = VPDSI_FILTER;
+    } else {
+        run->phase = VPDSI_DARTS;
+        run->darts_left = darts_for(total);
+    }
+    if (total > s->stats.peak_active_cells) s->stats.peak_active_cells = total;
+    if (s->stats.levels < 1) s->stats.levels = 1;
+    return VPDS_OK;
+}
+
+static void cell_coords(const vpds_sampler *s, uint64_t idx, uint64_t *c)
+{
+    const vpdsi_run *run = &s->run;
+    int k;
+    if (run->implicit) {
+        for (k = 0; k < s->dim; k++) {
+            c[k] = idx % run->n0[k];
+            idx /= run->n0[k];
+        }
+    } else {
+        vpdsi_cells_get(&run->cur, (size_t)idx, s->dim, c);
+    }
+}
+
+/* Box of the cell at `level` with integer coordinates c; the last cell of an axis ends exactly
+ * at the box's face. Returns the squared diagonal. */
+static double cell_box(const vpds_sampler *s, unsigned level, const uint64_t *c, double *lo,
+                       double *hi)
+{
+    const vpdsi_run *run = &s->run;
+    double diag2 = 0;
+    int k;
+    for (k = 0; k < s->dim; k++) {
+        double side = ldexp(run->side0[k], -(int)level);
+        uint64_t last = (run->n0[k] << level) - 1;
+        lo[k] = s->lo[k] + (double)c[k] * side;
+        hi[k] = c[k] == last ? s->hi[k] : s->lo[k] + (double)(c[k] + 1) * side;
+        diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    }
+    return diag2;
+}
+
+static unsigned cur_level(const vpds_sampler *s) { return s->run.implicit ? 0 : s->run.cur.level; }
+
+static uint64_t cur_count(const vpds_sampler *s)
+{
+    return s->run.implicit ? s->run.base_count : (uint64_t)s->run.cur.count;
+}
+
+/* n darts into out (n*dim): a cell uniformly, then a point uniformly in it. */
+static void draw_darts(const vpds_sampler *s, vpdsi_rng *rng, size_t n, double *out)
+{
+    uint64_t c[VPDS_MAX_DIM], total = cur_count(s);
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
+    unsigned level = cur_level(s);
+    size_t j;
+    int k, d = s->dim;
+    for (j = 0; j < n; j++) {
+        cell_coords(s, vpdsi_rng_below(rng, total), c);
+        cell_box(s, level, c, lo, hi);
+        for (k = 0; k < d; k++) {
+            double v = lo[k] + vpdsi_rng_unit(rng) * (hi[k] - lo[k]);
+            out[j * (size_t)d + (size_t)k] = v > hi[k] ? hi[k] : v;
+        }
+    }
+}
+
+static vpds_status reserve_buffers(vpds_sampler *s, size_t n)
+{
+    size_t nx;
+    if (vpdsi_mul_size(n, (size_t)s->dim, &nx) ||
+        vpdsi_mem_reserve(&s->mem, (void **)&s->buf_x, &s->cap_buf_x, nx, sizeof(double)) ||
+        vpdsi_mem_reserve(&s->mem, (void **)&s->buf_r, &s->cap_buf_r, n, sizeof(double))) {
+        vpdsi_set_error(s, "out of memory for a chunk of %zu points", n);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    return VPDS_OK;
+}
+
+static vpds_status darts_chunk(vpds_sampler *s, size_t n)
+{
+    int d = s->dim;
+    int varying = s->sizing.kind != VPDSI_SIZING_CONSTANT;
+    double scale = s->run.t * s->inhibition;
+    vpdsi_rng start = s->rng;
+    vpdsi_kd_samples view;
+    vpds_status st;
+    size_t j;
+    if ((st = reserve_buffers(s, n)) != VPDS_OK) return st;
+    if ((st = vpdsi_reserve_samples(s, n)) != VPDS_OK) return st;
+    draw_darts(s, &s->rng, n, s->buf_x);
+    if (varying) {
+        st = vpdsi_sizing_eval(&s->sizing, s->buf_x, n, s->buf_r, s->err, sizeof s->err);
+        if (st != VPDS_OK) {
+            s->rng = start; /* no draw spent: a retry throws the same darts */
+            return st;
+        }
+    } else {
+        for (j = 0; j < n; j++) s->buf_r[j] = s->sizing.radius;
+    }
+    for (j = 0; j < n; j++) {
+        const double *y = s->buf_x + j * (size_t)d;
+        int32_t witness = -1, hit;
+        view = vpdsi_samples_view(s);
+        hit = vpdsi_kd_conflict(&s->tree, &view, y, s->buf_r[j], (int)s->rule, scale,
+                                varying ? s->sizing.lipschitz : -1.0, &witness);
+        if (hit == -2) {
+            char py[256], px[256];
+            const double *x = s->x + (size_t)witness * (size_t)d;
+            double dist = 0;
+            int k;
+            for (k = 0; k < d; k++) dist += (y[k] - x[k]) * (y[k] - x[k]);
+            dist = sqrt(dist);
+            vpdsi_format_point(py, sizeof py, y, d);
+            vpdsi_format_point(px, sizeof px, x, d);
+            vpdsi_set_error(s, "sizing breaks lipschitz = %g: r = %.17g at (%s) and r = %.17g at"
+                            " (%s), distance %.17g, slope %.17g", s->sizing.lipschitz,
+                            s->buf_r[j], py, s->r[witness], px, dist,
+                            fabs(s->buf_r[j] - s->r[witness]) / dist);
+            /* keep the darts before this one, as a pause would */
+            s->rng = start;
+            draw_darts(s, &s->rng, j, s->buf_x);
+            s->run.darts_left -= j;
+            s->stats.darts += j;
+            return VPDS_ERR_LIPSCHITZ;
+        }
+        if (hit == -1) {
+            vpdsi_append_sample(s, y, s->buf_r[j], s->run.t, 0);
+            s->stats.accepted++;
+        }
+    }
+    s->run.darts_left -= n;
+    s->stats.darts += n;
+    return VPDS_OK;
+}
+
+static int box_covered(const vpds_sampler *s, const double *lo, const double *hi, double r_lo,
+                       double scale)
+{
+    size_t j;
+    for (j = 0; j < s->n_cand; j++) {
+        int32_t i = s->cand[j];
+        double f = scale * vpdsi_rule_f(s->rule, s->r[i], r_lo);
+        if (f > 0 && vpdsi_box_maxdist2(s->x + (size_t)i * (size_t)s->dim, lo, hi, s->dim) <= f * f)
+            return 1;
+    }
+    return 0;
+}
+
+/* Sweep n cells from run->pos: drop covered ones, keep the others (split: their uncovered
+ * children) in run->next. run->pos advances cell by cell, so an error mid-chunk loses nothing. */
+static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
+{
+    vpdsi_run *run = &s->run;
+    int d = s->dim, k;
+    unsigned level = cur_level(s), children = split ? 1u << d : 1u, b;
+    int need_r = vpdsi_rule_uses_y(s->rule) && s->sizing.kind != VPDSI_SIZING_CONSTANT;
+    double scale = run->t * s->coverage, L = s->sizing.lipschitz;
+    uint64_t c[VPDS_MAX_DIM], cc[VPDS_MAX_DIM];
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], clo[VPDS_MAX_DIM], chi[VPDS_MAX_DIM];
+    size_t j, need;
+    vpds_status st;
+    if (vpdsi_mul_size(n, children, &need) ||
+        vpdsi_cells_reserve(&run->next, &s->mem, run->next.count + need)) {
+        vpdsi_set_error(s, "out of memory for the active cells of level %u", run->next.level);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    if (need_r) {
+        /* r at the cell centres bounds r over each cell through L */
+        if ((st = reserve_buffers(s, n)) != VPDS_OK) return st;
+        for (j = 0; j < n; j++) {
+            cell_coords(s, run->pos + j, c);
+            cell_box(s, level, c, lo, hi);
+            for (k = 0; k < d; k++) s->buf_x[j * (size_t)d + (size_t)k] = 0.5 * (lo[k] + hi[k]);
+        }
+        st = vpdsi_sizing_eval(&s->sizing, s->buf_x, n, s->buf_r, s->err, sizeof s->err);
+        if (st != VPDS_OK) return st;
+    }
+    for (j = 0; j < n; j++) {
+        double h = sqrt(cell_box(s, level, (cell_coords(s, run->pos, c), c), lo, hi));
+        double r_lo = s->sizing.radius, r_hi = s->sizing.radius;
+        vpdsi_kd_samples view = vpdsi_samples_view(s);
+        if (need_r) {
+            r_lo = s->buf_r[j] - L * h / 2;
+            r_hi = s->buf_r[j] + L * h / 2;
+        }
+        s->n_cand = 0;
+        if (vpdsi_kd_gather(&s->tree, &view, lo, hi, r_hi, (int)s->rule, scale,
+                            split ? h / 4 : h / 2, &s->mem, &s->cand, &s->n_cand, &s->cap_cand)) {
+            vpdsi_set_error(s, "out of memory gathering the samples near a cell");
+            return VPDS_ERR_OUT_OF_MEMORY;
+        }
+        run->pos++;
+        if (box_covered(s, lo, hi, r_lo, scale)) continue;
+        if (!split) {
+            vpdsi_cells_push(&run->next, d, c);
+            continue;
+        }
+        for (b = 0; b < children; b++) {
+            for (k = 0; k < d; k++) cc[k] = 2 * c[k] + ((b >> k) & 1u);
+            cell_box(s, level + 1, cc, clo, chi);
+            if (!box_covered(s, clo, chi, r_lo, scale)) vpdsi_cells_push(&run->next, d, cc);
+        }
+    }
+    return VPDS_OK;
+}
+
+/* The sweep of a level is complete: its output becomes the active cells. */
+static void finish_sweep(vpds_sampler *s, int split)
+{
+    vpdsi_run *run = &s->run;
+    vpdsi_cells tmp = run->cur;
+    run->cur = run->next;
+    run->next = tmp;
+    run->implicit = 0;
+    run->pos = 0;
+    if (run->cur.count > s->stats.peak_active_cells) s->stats.peak_active_cells = run->cur.count;
+    if (run->cur.level + 1 > s->stats.levels) s->stats.levels = run->cur.level + 1;
+    if (run->cur.count == 0) {
+        run->phase = VPDSI_DONE;
+        s->stats.delta = 0;
+    } else if (!split && run->phase == VPDSI_SWEEP) {
+        /* precision limit: report how far from maximal the set may be */
+        uint64_t c[VPDS_MAX_DIM] = {0};
+        double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], worst = 0;
+        size_t i;
+        for (i = 0; i < run->cur.count; i++) {
+            double dg;
+            vpdsi_cells_get(&run->cur, i, s->dim, c);
+            dg = sqrt(cell_box(s, run->cur.level, c, lo, hi));
+            if (dg > worst) worst = dg;
+        }
+        s->stats.delta = worst;
+        run->phase = VPDSI_DONE;
+    } else {
+        run->phase = VPDSI_DARTS;
+        run->darts_left = darts_for(run->cur.count);
+    }
+    if (run->phase == VPDSI_DONE) vpdsi_mps_release(s);
+}
+
+static void begin_sweep(vpds_sampler *s, int split)
+{
+    vpdsi_cells_layout(&s->run.next, s->dim, s->run.n0, cur_level(s) + (split ? 1u : 0u));
+    s->run.pos = 0;
+}
+
+vpds_status vpdsi_mps_run(vpds_sampler *s)
+{
+    vpdsi_run *run = &s->run;
+    uint64_t work = 0;
+    vpds_status st = VPDS_OK;
+    if (run->phase == VPDSI_DONE) return VPDS_OK;
+    if (run->phase == VPDSI_IDLE) {
+        if ((st = setup(s)) != VPDS_OK) return st;
+        if (run->phase == VPDSI_FILTER) begin_sweep(s, 0);
+    }
+    for (;;) {
+        uint64_t limit = CHUNK, before;
+        if (run->phase == VPDSI_DONE) {
+            s->stats.maximal = 1;
+            return VPDS_OK;
+        }
+        if (s->budget && work >= s->budget) return VPDS_PAUSED;
+        if (s->budget && s->budget - work < limit) limit = s->budget - work;
+        switch (run->phase) {
+        case VPDSI_FILTER:
+        case VPDSI_SWEEP: {
+            int split = run->phase == VPDSI_SWEEP && cur_level(s) < run->max_level;
+            uint64_t total = cur_count(s);
+            before = run->pos;
+            if (total - run->pos < limit) limit = total - run->pos;
+            st = sweep_chunk(s, (size_t)limit, split);
+            work += run->pos - before;
+            if (st != VPDS_OK) return st;
+            if (run->pos == total) finish_sweep(s, split);
+            break;
+        }
+        case VPDSI_DARTS:
+            if (run->darts_left == 0) {
+                run->phase = VPDSI_SWEEP;
+                begin_sweep(s, cur_level(s) < run->max_level);
+                continue;
+            }
+            if (run->darts_left < limit) limit = run->darts_left;
+            before = run->darts_left;
+            st = darts_chunk(s, (size_t)limit);
+            work += before - run->darts_left;
+            if (st != VPDS_OK) return st;
+            break;
+        default:
+            return VPDS_ERR_STATE;
+        }
+        if (s->progress) {
+            vpds_progress p;
+            p.darts = s->stats.darts;
+            p.samples = s->n;
+            p.active_cells = run->phase == VPDSI_DONE ? 0 : cur_count(s);
+            p.level = cur_level(s);
+            p.t = run->t;
+            if (s->progress(&p, s->progress_user) != 0) {
+                if (run->phase == VPDSI_DONE) s->stats.maximal = 1;
+                return run->phase == VPDSI_DONE ? VPDS_OK : VPDS_PAUSED;
+            }
+        }
+    }
+}

@@ -1,0 +1,77 @@
+/* Private state of a vpds_sampler, shared by the public entry points and the MPS driver. */
+#ifndef VPDS_SAMPLER_H
+#define VPDS_SAMPLER_H
+#include "cells.h"
+#include "kdtree.h"
+#include "rng.h"
+#include "sizing.h"
+
+#define VPDSI_SAMPLER_MAGIC 0x56505353u /* 'VPSS' */
+#define VPDSI_DESC_COOKIE 0x56504431u    /* 'VPD1': layout 1 of vpds_desc */
+
+typedef enum {
+    VPDSI_IDLE,   /* nothing set up at the current scale */
+    VPDSI_FILTER, /* dropping base cells covered by samples that existed before the run */
+    VPDSI_DARTS,  /* throwing the darts of the current level */
+    VPDSI_SWEEP,  /* coverage sweep: splitting active cells, keeping uncovered children */
+    VPDSI_DONE    /* maximal at the current scale */
+} vpdsi_phase;
+
+/* Algorithm 1's state between chunks of work; a pause or an error leaves it consistent. */
+typedef struct vpdsi_run {
+    vpdsi_phase phase;
+    double t;                      /* scale */
+    uint64_t n0[VPDS_MAX_DIM];     /* base cells per axis */
+    double side0[VPDS_MAX_DIM];    /* base cell side per axis */
+    uint64_t base_count;           /* prod n0 */
+    unsigned max_level;            /* precision limit */
+    int implicit;                  /* the level-0 cells are all base cells, not stored */
+    vpdsi_cells cur, next;
+    uint64_t pos;                  /* cells of cur swept so far */
+    uint64_t darts_left;           /* darts still to throw at this level */
+} vpdsi_run;
+
+struct vpds_sampler {
+    uint32_t magic;
+    vpdsi_mem mem;
+    int dim;
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
+    vpds_rule rule;
+    double inhibition, coverage;
+    int weighted;
+    vpdsi_sizing sizing;
+    vpdsi_rng rng;
+    uint64_t budget;
+    vpds_progress_fn progress;
+    void *progress_user;
+
+    /* samples, insertion order */
+    size_t n;
+    double *x; size_t cap_x;
+    double *r; size_t cap_r;
+    double *t; size_t cap_t;
+    uint8_t *flags; size_t cap_flags;
+    vpdsi_kdtree tree;
+
+    vpdsi_run run;
+    vpds_stats stats;
+
+    /* scratch reused between chunks */
+    int32_t *cand; size_t n_cand, cap_cand;
+    double *buf_x; size_t cap_buf_x;
+    double *buf_r; size_t cap_buf_r;
+    char err[512];
+};
+
+void vpdsi_set_error(vpds_sampler *s, const char *fmt, ...);
+/* Room for `more` samples in every per-sample array and the tree; nothing changes on failure. */
+vpds_status vpdsi_reserve_samples(vpds_sampler *s, size_t more);
+/* Append and index a sample (after vpdsi_reserve_samples). */
+void vpdsi_append_sample(vpds_sampler *s, const double *x, double r, double t, uint8_t flags);
+vpdsi_kd_samples vpdsi_samples_view(const vpds_sampler *s);
+
+/* mps.c: Algorithm 1 */
+void vpdsi_mps_reset(vpds_sampler *s, double t);
+vpds_status vpdsi_mps_run(vpds_sampler *s);
+void vpdsi_mps_release(vpds_sampler *s);
+#endif
