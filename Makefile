@@ -20,7 +20,10 @@ TEST_SRC := $(sort $(wildcard tests/test_*.c))
 TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 FLANN_TEST := $(BUILD)/tests/flann_kdtree
 
-.PHONY: all test demo deps install clean bench check-c check-flann
+SAMPLE_TOOL := $(BUILD)/tests/sample_tool
+SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+
+.PHONY: all test demo deps install clean bench check-c check-flann check-py check-sanitizers
 all: $(SHARED) $(STATIC) $(BUILD)/vpds.pc
 
 $(BUILD)/obj/%.o: libvpds/%.c $(LIB_HDR)
@@ -45,6 +48,10 @@ $(BUILD)/tests/%: tests/%.c tests/check.h $(STATIC)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_TEST) $< -o $@ $(STATIC) -lm
 
+$(SAMPLE_TOOL): tests/tools/sample_tool.c $(STATIC)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_TEST) $< -o $@ $(STATIC) -lm
+
 $(FLANN_TEST): tests/flann_kdtree.c tests/check.h $(STATIC)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_TEST) $< -o $@ $(STATIC) -lflann -lm
@@ -59,11 +66,27 @@ check-c: $(TEST_BIN)
 check-flann: $(FLANN_TEST)
 	$(FLANN_TEST)
 
-test: all check-c check-flann
+check-py: $(SAMPLE_TOOL)
+	python3 -m pytest -q tests/py
+
+# The C tests again with AddressSanitizer and UndefinedBehaviorSanitizer (a separate build).
+check-sanitizers:
+	$(MAKE) --no-print-directory BUILD=$(BUILD)/san OPT=-O1 EXTRA_CFLAGS="$(SAN_FLAGS)" \
+	  CC="$(CC) $(SAN_FLAGS)" check-c
+
+# A fresh machine: install the dependencies once (the stamp remembers), then every check.
+DEPS_STAMP := $(BUILD)/.deps-installed
+$(DEPS_STAMP): tools/deps.sh tests/requirements.txt
+	bash tools/deps.sh
+	@mkdir -p $(BUILD) && touch $@
+
+test: $(DEPS_STAMP)
+	$(MAKE) --no-print-directory all check-c check-flann check-sanitizers check-py
 	@echo "all tests passed"
 
 demo: $(BUILD)/demo/figure1
-	$(BUILD)/demo/figure1 $(BUILD)/demo
+	@mkdir -p out
+	$(BUILD)/demo/figure1 out
 
 deps:
 	bash tools/deps.sh

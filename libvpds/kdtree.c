@@ -282,3 +282,16 @@ int vpdsi_kd_radius(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const doub
     }
     return 0;
 }
+
+int vpdsi_kd_box_covered(const vpdsi_kd_samples *s, int dim, const int32_t *cand, size_t n,
+                         const double *lo, const double *hi, double r_lo, int rule, double scale)
+{
+    size_t j;
+    for (j = 0; j < n; j++) {
+        int32_t i = cand[j];
+        double f = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_lo);
+        if (f > 0 && vpdsi_box_maxdist2(s->x + (size_t)i * (size_t)dim, lo, hi, dim) <= f * f)
+            return 1;
+    }
+    return 0;
+}

@@ -65,6 +65,12 @@ int vpdsi_kd_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const doub
                     const double *hi, double r_hi, int rule, double scale, double min_reach,
                     vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap);
 
+/* BiX (prior) / XiB (current) and their combinations, on candidates from vpdsi_kd_gather:
+ * whether one candidate covers the whole box, |y - x| <= scale * f(r(x), r_lo) for every y in
+ * it, r_lo bounding r over the box from below. The farthest corner is tested exactly. */
+int vpdsi_kd_box_covered(const vpdsi_kd_samples *s, int dim, const int32_t *cand, size_t n,
+                         const double *lo, const double *hi, double r_lo, int rule, double scale);
+
 /* All samples with |x - p| <= radius, appended to *out; -1 on OOM. */
 int vpdsi_kd_radius(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *p,
                     double radius, vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap);

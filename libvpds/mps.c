@@ -214,14 +214,8 @@ static vpds_status darts_chunk(vpds_sampler *s, size_t n)
 static int box_covered(const vpds_sampler *s, const double *lo, const double *hi, double r_lo,
                        double scale)
 {
-    size_t j;
-    for (j = 0; j < s->n_cand; j++) {
-        int32_t i = s->cand[j];
-        double f = scale * vpdsi_rule_f(s->rule, s->r[i], r_lo);
-        if (f > 0 && vpdsi_box_maxdist2(s->x + (size_t)i * (size_t)s->dim, lo, hi, s->dim) <= f * f)
-            return 1;
-    }
-    return 0;
+    vpdsi_kd_samples view = vpdsi_samples_view(s);
+    return vpdsi_kd_box_covered(&view, s->dim, s->cand, s->n_cand, lo, hi, r_lo, (int)s->rule, scale);
 }
 
 /* Sweep n cells from run->pos: drop covered ones, keep the others (split: their uncovered

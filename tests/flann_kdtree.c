@@ -1,0 +1,190 @@
+/* The kd-tree against FLANN's exact search (a single kd-tree with unlimited checks): radius
+ * queries and the answer of each proximity primitive (PiX, XiP, BiX, XiB and the bigger/smaller
+ * combinations), on random, clustered and degenerate inputs (duplicates, points on splitting
+ * planes), in 1D to 6D. FLANN takes the radius as a float of the squared distance, so points
+ * within a relative 1e-5 of a query's boundary are left out of the comparison. */
+#include "check.h"
+#include "kdtree.h"
+#include "mem.h"
+#include "rules.h"
+#include <flann/flann.h>
+#include <math.h>
+#include <string.h>
+
+#define NMAX 4000
+
+static uint64_t state = 99;
+static double unit(void)
+{
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return (double)(state >> 11) * (1.0 / 9007199254740992.0);
+}
+
+typedef struct {
+    flann_index_t index;
+    struct FLANNParameters params;
+    int *idx;
+    double *dist;
+} flann_ref;
+
+/* FLANN: indices within radius of q; returns count (every point at most, so nothing is cut) */
+static int flann_within(flann_ref *f, int n, double *q, double radius)
+{
+    return flann_radius_search_double(f->index, q, f->idx, f->dist, n, (float)(radius * radius),
+                                      &f->params);
+}
+
+static int in_band(double d2, double radius)
+{
+    return fabs(d2 - radius * radius) <= 1e-5 * radius * radius + 1e-300;
+}
+
+static double dist2(const double *a, const double *b, int d)
+{
+    double s = 0;
+    int k;
+    for (k = 0; k < d; k++) s += (a[k] - b[k]) * (a[k] - b[k]);
+    return s;
+}
+
+static int compared = 0, skipped = 0;
+
+static void check_set(const char *name, int dim, int n, double *x, double *r)
+{
+    vpdsi_mem m;
+    vpdsi_kdtree t;
+    vpdsi_kd_samples s;
+    flann_ref f;
+    float speedup;
+    uint8_t flags[NMAX];
+    int32_t *out = NULL, i;
+    size_t cnt = 0, cap = 0;
+    int q, k, rule;
+    double rmax = 0;
+    char *mark = (char *)calloc((size_t)n, 1);
+    vpdsi_mem_init(&m, NULL);
+    vpdsi_kd_init(&t, dim);
+    memset(flags, 0, sizeof flags);
+    s.x = x; s.r = r; s.flags = flags;
+    CHECK(vpdsi_kd_reserve(&t, &m, (size_t)n, (size_t)n) == 0);
+    for (i = 0; i < n; i++) {
+        vpdsi_kd_insert(&t, &s, i);
+        if (r[i] > rmax) rmax = r[i];
+    }
+    f.params = DEFAULT_FLANN_PARAMETERS;
+    f.params.algorithm = FLANN_INDEX_KDTREE_SINGLE;
+    f.params.checks = FLANN_CHECKS_UNLIMITED;
+    f.params.log_level = FLANN_LOG_NONE;
+    f.index = flann_build_index_double(x, n, dim, &speedup, &f.params);
+    f.idx = (int *)malloc(sizeof(int) * (size_t)n);
+    f.dist = (double *)malloc(sizeof(double) * (size_t)n);
+    CHECK(f.index != NULL);
+    for (q = 0; q < 300; q++) {
+        double p[6], radius = (0.2 + unit()) * rmax * 2, rp = r[q % n];
+        int nf, j, bad = 0;
+        /* queries: random, on a data point, on a data point's coordinate planes */
+        for (k = 0; k < dim; k++) {
+            if (q % 3 == 0) p[k] = unit() * 1.2 - 0.1;
+            else if (q % 3 == 1) p[k] = x[(q % n) * dim + k];
+            else p[k] = x[((q * 7) % n) * dim + k] + (k % 2 ? 0 : 1e-3);
+        }
+        /* radius search */
+        cnt = 0;
+        CHECK(vpdsi_kd_radius(&t, &s, p, radius, &m, &out, &cnt, &cap) == 0);
+        nf = flann_within(&f, n, p, radius);
+        memset(mark, 0, (size_t)n);
+        for (j = 0; j < (int)cnt; j++) mark[out[j]] |= 1;
+        for (j = 0; j < nf; j++) mark[f.idx[j]] |= 2;
+        for (i = 0; i < n; i++) {
+            if (mark[i] == 0 || mark[i] == 3) { compared++; continue; }
+            if (in_band(dist2(p, x + i * dim, dim), radius)) { skipped++; continue; }
+            bad++;
+        }
+        CHECK_MSG(bad == 0, "%s: radius search differs from FLANN at %d points", name, bad);
+        /* each rule's conflict primitive: any x with |p - x| < f(r(x), rp) */
+        nf = flann_within(&f, n, p, rmax > rp ? rmax : rp);
+        for (rule = VPDS_RULE_PRIOR; rule <= VPDS_RULE_SMALLER; rule++) {
+            int32_t w, ours = vpdsi_kd_conflict(&t, &s, p, rp, rule, 1.0, -1.0, &w) >= 0, ref = 0,
+                       ambiguous = 0;
+            for (j = 0; j < nf; j++) {
+                int id = f.idx[j];
+                double fr = vpdsi_rule_f((vpds_rule)rule, r[id], rp), d2 = dist2(p, x + id * dim, dim);
+                if (d2 < fr * fr) ref = 1;
+                if (in_band(d2, fr)) ambiguous = 1;
+            }
+            if (ours != ref && !ambiguous)
+                CHECK_MSG(0, "%s: conflict rule %d: ours %d, FLANN %d", name, rule, ours, ref);
+        }
+        /* each rule's box coverage primitive on a box around p */
+        {
+            double lo[6], hi[6], side = rmax * (0.05 + 0.5 * unit()), half = 0, c[6];
+            for (k = 0; k < dim; k++) {
+                lo[k] = p[k] - side / 2;
+                hi[k] = p[k] + side / 2;
+                c[k] = p[k];
+                half += side * side / 4;
+            }
+            half = sqrt(half);
+            nf = flann_within(&f, n, c, (rmax > rp ? rmax : rp) + half);
+            for (rule = VPDS_RULE_PRIOR; rule <= VPDS_RULE_SMALLER; rule++) {
+                int ours, ref = 0, ambiguous = 0;
+                cnt = 0;
+                CHECK(vpdsi_kd_gather(&t, &s, lo, hi, rp, rule, 1.0, 0.0, &m, &out, &cnt, &cap) == 0);
+                ours = vpdsi_kd_box_covered(&s, dim, out, cnt, lo, hi, rp, rule, 1.0);
+                for (j = 0; j < nf; j++) {
+                    int id = f.idx[j];
+                    double fr = vpdsi_rule_f((vpds_rule)rule, r[id], rp);
+                    double far2 = vpdsi_box_maxdist2(x + id * dim, lo, hi, dim);
+                    if (far2 <= fr * fr) ref = 1;
+                    if (in_band(far2, fr)) ambiguous = 1;
+                }
+                if (ours != ref && !ambiguous)
+                    CHECK_MSG(0, "%s: box coverage rule %d: ours %d, FLANN %d", name, rule, ours, ref);
+            }
+        }
+    }
+    flann_free_index_double(f.index, &f.params);
+    free(f.idx);
+    free(f.dist);
+    vpdsi_mem_free(&m, out, cap * sizeof *out);
+    free(mark);
+    vpdsi_kd_release(&t, &m);
+    CHECK(m.held == 0);
+}
+
+int main(void)
+{
+    static double x[NMAX * 6], r[NMAX];
+    int dims[] = {1, 2, 3, 6}, di, i, k;
+    for (di = 0; di < 4; di++) {
+        int d = dims[di], n = 3000;
+        char name[64];
+        /* random */
+        for (i = 0; i < n * d; i++) x[i] = unit();
+        for (i = 0; i < n; i++) r[i] = 0.01 + 0.1 * unit();
+        snprintf(name, sizeof name, "random %dD", d);
+        check_set(name, d, n, x, r);
+        /* clustered: tight Gaussian-ish clusters */
+        for (i = 0; i < n; i++) {
+            int c = i % 7;
+            for (k = 0; k < d; k++)
+                x[i * d + k] = 0.1 + 0.12 * c + 0.01 * (unit() + unit() + unit() - 1.5);
+        }
+        snprintf(name, sizeof name, "clustered %dD", d);
+        check_set(name, d, n, x, r);
+        /* duplicates: 40 distinct points, each repeated */
+        for (i = 0; i < n; i++)
+            for (k = 0; k < d; k++) x[i * d + k] = (i < 40) ? unit() : x[(i % 40) * d + k];
+        snprintf(name, sizeof name, "duplicates %dD", d);
+        check_set(name, d, n, x, r);
+        /* a lattice: many points share every coordinate, so they sit on splitting planes */
+        for (i = 0; i < n; i++)
+            for (k = 0; k < d; k++) x[i * d + k] = (double)((i / (k + 1)) % 5) / 4.0;
+        snprintf(name, sizeof name, "lattice %dD", d);
+        check_set(name, d, n, x, r);
+    }
+    printf("FLANN comparisons: %d points agreed, %d within float rounding of a boundary\n",
+           compared, skipped);
+    CHECK(compared > 1000000);
+    CHECK_DONE();
+}

@@ -1,0 +1,222 @@
+/* The C API: determinism by seed, budgets and pauses resume to the same points, fixed points,
+ * the custom allocator (every allocation failure recovers to the same points, nothing leaks). */
+#include "check.h"
+#include "vpds.h"
+#include <math.h>
+#include <string.h>
+
+static double ramp(const double *x, void *u) { (void)u; return 0.001 + 0.3 * x[0]; }
+
+typedef struct {
+    size_t live_bytes, calls, fail_at; /* fail_at: the allocation that fails (0: none) */
+    int failed;
+} counting_alloc;
+
+static void *ca_alloc(size_t size, void *user)
+{
+    counting_alloc *a = (counting_alloc *)user;
+    a->calls++;
+    if (a->fail_at && a->calls == a->fail_at) {
+        a->failed = 1;
+        return NULL;
+    }
+    a->live_bytes += size;
+    return malloc(size);
+}
+static void ca_free(void *p, size_t size, void *user)
+{
+    counting_alloc *a = (counting_alloc *)user;
+    a->live_bytes -= size;
+    free(p);
+}
+
+static vpds_desc ramp_desc(uint64_t seed)
+{
+    vpds_desc d = vpds_default_desc();
+    d.sizing = ramp;
+    d.lipschitz = 0.3;
+    d.rule = VPDS_RULE_PRIOR;
+    d.seed = seed;
+    return d;
+}
+
+/* Run to completion; returns a malloc'd copy of the points and writes the count. */
+static double *run_copy(const vpds_desc *d, size_t *n)
+{
+    vpds_sampler *s = NULL;
+    double *copy;
+    vpds_status st = vpds_create(d, &s);
+    if (st != VPDS_OK) return NULL;
+    while ((st = vpds_run(s)) == VPDS_PAUSED) {}
+    if (st != VPDS_OK) {
+        vpds_destroy(s);
+        return NULL;
+    }
+    *n = vpds_count(s);
+    copy = (double *)malloc(*n * 2 * sizeof(double));
+    memcpy(copy, vpds_points(s), *n * 2 * sizeof(double));
+    vpds_destroy(s);
+    return copy;
+}
+
+static int pause_every_third(const vpds_progress *p, void *user)
+{
+    int *calls = (int *)user;
+    (void)p;
+    return ++*calls % 3 == 0;
+}
+
+int main(void)
+{
+    vpds_desc d = ramp_desc(42);
+    size_t n_ref, n, i;
+    double *ref = run_copy(&d, &n_ref), *other;
+    CHECK(ref != NULL && n_ref > 1000);
+
+    /* same seed, same bytes; another seed, other points */
+    other = run_copy(&d, &n);
+    CHECK(other && n == n_ref && memcmp(ref, other, n * 2 * sizeof(double)) == 0);
+    free(other);
+    d.seed = 43;
+    other = run_copy(&d, &n);
+    CHECK(other && (n != n_ref || memcmp(ref, other, n * 2 * sizeof(double)) != 0));
+    free(other);
+
+    /* budgets of several sizes: paused many times, same points */
+    {
+        uint64_t budgets[] = {1, 37, 1000};
+        for (i = 0; i < 3; i++) {
+            vpds_sampler *s;
+            int pauses = 0;
+            vpds_status st;
+            d = ramp_desc(42);
+            d.budget = budgets[i];
+            CHECK(vpds_create(&d, &s) == VPDS_OK);
+            while ((st = vpds_run(s)) == VPDS_PAUSED) {
+                pauses++;
+                /* the samples so far are readable and a prefix of the final set */
+                CHECK(vpds_count(s) <= n_ref);
+                if (vpds_count(s))
+                    CHECK(memcmp(vpds_points(s), ref, vpds_count(s) * 2 * sizeof(double)) == 0);
+            }
+            CHECK(st == VPDS_OK && pauses > 0);
+            CHECK_MSG(vpds_count(s) == n_ref &&
+                      memcmp(vpds_points(s), ref, n_ref * 2 * sizeof(double)) == 0,
+                      "budget %llu", (unsigned long long)budgets[i]);
+            CHECK(vpds_get_stats(s).maximal);
+            vpds_destroy(s);
+        }
+    }
+
+    /* the progress callback pauses; calling again continues to the same points */
+    {
+        vpds_sampler *s;
+        int calls = 0, pauses = 0;
+        vpds_status st;
+        d = ramp_desc(42);
+        d.progress = pause_every_third;
+        d.progress_user = &calls;
+        CHECK(vpds_create(&d, &s) == VPDS_OK);
+        while ((st = vpds_run(s)) == VPDS_PAUSED) pauses++;
+        CHECK(st == VPDS_OK && pauses > 3);
+        CHECK(vpds_count(s) == n_ref && memcmp(vpds_points(s), ref, n_ref * 2 * sizeof(double)) == 0);
+        vpds_destroy(s);
+    }
+
+    /* results: radii are r(x), scales 1, statistics filled */
+    {
+        vpds_sampler *s;
+        vpds_stats st;
+        d = ramp_desc(42);
+        CHECK(vpds_create(&d, &s) == VPDS_OK && vpds_run(s) == VPDS_OK);
+        for (i = 0; i < vpds_count(s); i++) {
+            CHECK(vpds_radii(s)[i] == ramp(vpds_points(s) + 2 * i, NULL));
+            CHECK(vpds_scales(s)[i] == 1.0 && vpds_flags(s)[i] == 0);
+        }
+        st = vpds_get_stats(s);
+        CHECK(st.darts >= st.accepted && st.accepted == vpds_count(s));
+        CHECK(st.levels > 1 && st.peak_active_cells > 0 && st.peak_bytes >= st.bytes_held);
+        CHECK(st.bytes_held > vpds_count(s) * 2 * sizeof(double) && st.maximal && st.delta == 0);
+        CHECK(vpds_run(s) == VPDS_OK && vpds_get_stats(s).darts == st.darts); /* already maximal */
+        vpds_destroy(s);
+    }
+
+    /* fixed points: kept first, flagged, t = inf, respected by later samples */
+    {
+        vpds_sampler *s;
+        double fx[] = {0.5, 0.5, 0.2, 0.8, 3.0, 3.0}, fr[] = {0.2, 0.05, 0.5};
+        d = vpds_default_desc();
+        d.radius = 0.03;
+        d.seed = 1;
+        CHECK(vpds_create(&d, &s) == VPDS_OK);
+        CHECK(vpds_add_points(s, fx, fr, 3) == VPDS_OK);
+        CHECK(vpds_run(s) == VPDS_OK);
+        CHECK(vpds_count(s) > 100);
+        for (i = 0; i < 3; i++) {
+            CHECK(vpds_flags(s)[i] == (VPDS_FLAG_FIXED | VPDS_FLAG_OWN_RADIUS));
+            CHECK(isinf(vpds_scales(s)[i]) && vpds_radii(s)[i] == fr[i]);
+            CHECK(vpds_points(s)[2 * i] == fx[2 * i] && vpds_points(s)[2 * i + 1] == fx[2 * i + 1]);
+        }
+        for (i = 3; i < vpds_count(s); i++) {
+            const double *p = vpds_points(s) + 2 * i;
+            double d0 = hypot(p[0] - 0.5, p[1] - 0.5), d1 = hypot(p[0] - 0.2, p[1] - 0.8);
+            /* smaller rule: min(r_fixed, 0.03) */
+            CHECK(d0 >= 0.03 && d1 >= 0.03);
+        }
+        /* added between runs: still maximal, nothing to do */
+        {
+            double more[] = {0.9, 0.1};
+            size_t before = vpds_count(s);
+            CHECK(vpds_add_points(s, more, NULL, 1) == VPDS_OK);
+            CHECK(vpds_count(s) == before + 1 && vpds_radii(s)[before] == 0.03);
+            CHECK(vpds_flags(s)[before] == VPDS_FLAG_FIXED);
+            CHECK(vpds_run(s) == VPDS_OK && vpds_count(s) == before + 1);
+        }
+        vpds_destroy(s);
+    }
+
+    /* allocator: count the allocations of a run, then fail each one in turn */
+    {
+        counting_alloc ca;
+        vpds_sampler *s = NULL;
+        size_t total, k, reached = 0;
+        memset(&ca, 0, sizeof ca);
+        d = ramp_desc(42);
+        d.allocator.alloc = ca_alloc;
+        d.allocator.free = ca_free;
+        d.allocator.user = &ca;
+        CHECK(vpds_create(&d, &s) == VPDS_OK && vpds_run(s) == VPDS_OK);
+        CHECK(vpds_count(s) == n_ref && memcmp(vpds_points(s), ref, n_ref * 2 * sizeof(double)) == 0);
+        vpds_destroy(s);
+        CHECK(ca.live_bytes == 0);
+        total = ca.calls;
+        CHECK(total > 10);
+        for (k = 1; k <= total; k++) {
+            vpds_status st;
+            memset(&ca, 0, sizeof ca);
+            ca.fail_at = k;
+            s = NULL;
+            st = vpds_create(&d, &s);
+            if (st == VPDS_OK) {
+                while ((st = vpds_run(s)) == VPDS_ERR_OUT_OF_MEMORY) {
+                    CHECK(ca.failed);
+                    CHECK(strlen(vpds_last_error(s)) > 0);
+                    ca.fail_at = 0; /* memory is back: continue */
+                    reached++;
+                }
+                CHECK_MSG(st == VPDS_OK && vpds_count(s) == n_ref &&
+                          memcmp(vpds_points(s), ref, n_ref * 2 * sizeof(double)) == 0,
+                          "after failing allocation %zu", k);
+                vpds_destroy(s);
+            } else {
+                CHECK(st == VPDS_ERR_OUT_OF_MEMORY && s == NULL);
+                reached++;
+            }
+            CHECK_MSG(ca.live_bytes == 0, "leak after failing allocation %zu", k);
+        }
+        CHECK(reached == total);
+        printf("allocation failure: %zu allocation sites of a ramp run each failed once\n", total);
+    }
+    free(ref);
+    CHECK_DONE();
+}
