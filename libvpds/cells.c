@@ -57,6 +57,12 @@ void vpdsi_cells_get(const vpdsi_cells *c, size_t i, int dim, uint64_t *coord)
 {
     const uint64_t *w = c->words + i * c->words_per_cell;
     unsigned k;
+    if (c->words_per_cell == 1) { /* the common case: every coordinate in one word */
+        uint64_t v = w[0];
+        for (k = 0; k < (unsigned)dim; k++)
+            coord[k] = (v >> c->offset[k]) & ((UINT64_C(1) << c->bits[k]) - 1);
+        return;
+    }
     for (k = 0; k < (unsigned)dim; k++) {
         unsigned off = c->offset[k], wi = off >> 6, sh = off & 63u, b = c->bits[k];
         uint64_t v = w[wi] >> sh;

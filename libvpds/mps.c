@@ -11,7 +11,9 @@
 #include <math.h>
 #include <string.h>
 
+#ifndef DARTS_PER_CELL
 #define DARTS_PER_CELL 0.5  /* A of Algorithm 1 */
+#endif
 #define CHUNK 256           /* darts or cells between checks of the budget */
 #define PRECISION_BITS 44   /* cells stop splitting at 2^-44 of the coordinates' magnitude */
 
@@ -27,19 +29,48 @@ void vpdsi_mps_release(vpds_sampler *s)
 {
     vpdsi_cells_release(&s->run.cur, &s->mem);
     vpdsi_cells_release(&s->run.next, &s->mem);
+    if (s->grid_mode) {
+        /* done at this scale: keep the samples, drop the accelerator (rebuilt on the next run) */
+        vpdsi_bgrid_release(&s->grid, &s->mem);
+        s->grid_mode = 0;
+    }
 }
 
-static uint64_t darts_for(uint64_t cells)
+#ifndef DARTS_PER_BASE_CELL
+#define DARTS_PER_BASE_CELL 1.5 /* level 0 darts are the cheapest: no cell to read */
+#endif
+static uint64_t darts_for(uint64_t cells, unsigned level)
 {
-    double n = ceil(DARTS_PER_CELL * (double)cells);
+    double n = ceil((level ? DARTS_PER_CELL : DARTS_PER_BASE_CELL) * (double)cells);
     return n < 1 ? 1 : (uint64_t)n;
 }
 
 /* Base grid for the current scale: cells of diagonal t*coverage*r_max, so that in the uniform
  * case a sample covers its whole cell. */
+/* The background grid serves a uniform radius in low dimension; the kd-tree everything else. */
+static vpds_status choose_index(vpds_sampler *s)
+{
+    vpdsi_run *run = &s->run;
+    double reach = run->t * s->inhibition * s->sizing.radius;
+    size_t i;
+    vpdsi_bgrid_release(&s->grid, &s->mem);
+    s->grid_mode = 0;
+    if (s->sizing.kind == VPDSI_SIZING_CONSTANT && s->n_fixed == 0 && s->dim <= 3 &&
+        vpdsi_bgrid_setup(&s->grid, &s->mem, s->dim, run->n0, s->lo, run->side0, reach) == 0 &&
+        vpdsi_mem_reserve(&s->mem, (void **)&s->cand, &s->cap_cand, s->grid.n_stencil + 1,
+                          sizeof(int32_t)) == 0) {
+        s->grid_mode = 1;
+        for (i = 0; i < s->n; i++) s->grid.cell[vpdsi_bgrid_locate(&s->grid, s->x + i * (size_t)s->dim)] = (int32_t)i;
+        return VPDS_OK;
+    }
+    vpdsi_bgrid_release(&s->grid, &s->mem);
+    return vpdsi_sync_tree(s);
+}
+
 static vpds_status setup(vpds_sampler *s)
 {
     vpdsi_run *run = &s->run;
+    vpds_status st;
     int d = s->dim, k;
     double target = run->t * s->coverage * s->sizing.rmax / sqrt((double)d) * (1 - 1e-9);
     uint64_t total = 1;
@@ -70,6 +101,7 @@ static vpds_status setup(vpds_sampler *s)
     }
     run->base_count = total;
     run->max_level = max_level;
+    if ((st = choose_index(s)) != VPDS_OK) return st;
     run->implicit = 1;
     run->pos = 0;
     vpdsi_cells_layout(&run->cur, d, run->n0, 0);
@@ -78,7 +110,7 @@ static vpds_status setup(vpds_sampler *s)
         run->phase = VPDSI_FILTER;
     } else {
         run->phase = VPDSI_DARTS;
-        run->darts_left = darts_for(total);
+        run->darts_left = darts_for(total, 0);
     }
     if (total > s->stats.peak_active_cells) s->stats.peak_active_cells = total;
     if (s->stats.levels < 1) s->stats.levels = 1;
@@ -154,6 +186,26 @@ static vpds_status reserve_buffers(vpds_sampler *s, size_t n)
     return VPDS_OK;
 }
 
+static int32_t grid_conflict(const vpds_sampler *s, const double *y, double reach)
+{
+    const vpdsi_bgrid *g = &s->grid;
+    const int32_t *cell = g->cell + vpdsi_bgrid_locate(g, y);
+    double reach2 = reach * reach;
+    size_t j;
+    int k, d = s->dim;
+    if (cell[0] >= 0) return cell[0]; /* a cell holds one sample: any other point conflicts */
+    for (j = 0; j < g->n_stencil; j++) {
+        int32_t i = cell[g->stencil[j]];
+        if (i >= 0) {
+            const double *x = s->x + (size_t)i * (size_t)d;
+            double d2 = 0;
+            for (k = 0; k < d; k++) d2 += (y[k] - x[k]) * (y[k] - x[k]);
+            if (d2 < reach2) return i;
+        }
+    }
+    return -1;
+}
+
 static vpds_status darts_chunk(vpds_sampler *s, size_t n)
 {
     int d = s->dim;
@@ -178,9 +230,13 @@ static vpds_status darts_chunk(vpds_sampler *s, size_t n)
     for (j = 0; j < n; j++) {
         const double *y = s->buf_x + j * (size_t)d;
         int32_t witness = -1, hit;
-        view = vpdsi_samples_view(s);
-        hit = vpdsi_kd_conflict(&s->tree, &view, y, s->buf_r[j], (int)s->rule, scale,
-                                varying ? s->sizing.lipschitz : -1.0, &witness);
+        if (s->grid_mode) {
+            hit = grid_conflict(s, y, scale * s->sizing.radius);
+        } else {
+            view = vpdsi_samples_view(s);
+            hit = vpdsi_kd_conflict(&s->tree, &view, y, s->buf_r[j], (int)s->rule, scale,
+                                    varying ? s->sizing.lipschitz : -1.0, &witness);
+        }
         if (hit == -2) {
             char py[256], px[256];
             const double *x = s->x + (size_t)witness * (size_t)d;
@@ -256,7 +312,11 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
             r_hi = s->buf_r[j] + L * h / 2;
         }
         s->n_cand = 0;
-        if (vpdsi_kd_gather(&s->tree, &view, lo, hi, r_hi, (int)s->rule, scale,
+        if (s->grid_mode) {
+            uint64_t base[VPDS_MAX_DIM];
+            for (k = 0; k < d; k++) base[k] = c[k] >> level; /* the base cell holding this one */
+            s->n_cand = vpdsi_bgrid_near(&s->grid, vpdsi_bgrid_index(&s->grid, base), s->cand);
+        } else if (vpdsi_kd_gather(&s->tree, &view, lo, hi, r_hi, (int)s->rule, scale,
                             split ? h / 4 : h / 2, &s->mem, &s->cand, &s->n_cand, &s->cap_cand)) {
             vpdsi_set_error(s, "out of memory gathering the samples near a cell");
             return VPDS_ERR_OUT_OF_MEMORY;
@@ -305,7 +365,7 @@ static void finish_sweep(vpds_sampler *s, int split)
         run->phase = VPDSI_DONE;
     } else {
         run->phase = VPDSI_DARTS;
-        run->darts_left = darts_for(run->cur.count);
+        run->darts_left = darts_for(run->cur.count, run->cur.level);
     }
     if (run->phase == VPDSI_DONE) vpdsi_mps_release(s);
 }

@@ -37,23 +37,39 @@ vpds_status vpdsi_reserve_samples(vpds_sampler *s, size_t more)
         vpdsi_mem_reserve(&s->mem, (void **)&s->r, &s->cap_r, need, sizeof(double)) ||
         vpdsi_mem_reserve(&s->mem, (void **)&s->t, &s->cap_t, need, sizeof(double)) ||
         vpdsi_mem_reserve(&s->mem, (void **)&s->flags, &s->cap_flags, need, 1) ||
-        vpdsi_kd_reserve(&s->tree, &s->mem, need, more)) {
+        (!s->grid_mode && vpdsi_kd_reserve(&s->tree, &s->mem, need, need - s->tree_n))) {
         vpdsi_set_error(s, "out of memory for %zu samples", need);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
     return VPDS_OK;
 }
 
+vpds_status vpdsi_sync_tree(vpds_sampler *s)
+{
+    vpdsi_kd_samples v = vpdsi_samples_view(s);
+    if (s->tree_n == s->n) return VPDS_OK;
+    if (vpdsi_kd_reserve(&s->tree, &s->mem, s->n, s->n - s->tree_n)) {
+        vpdsi_set_error(s, "out of memory indexing %zu samples", s->n);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    while (s->tree_n < s->n) vpdsi_kd_insert(&s->tree, &v, (int32_t)s->tree_n++);
+    return VPDS_OK;
+}
+
 void vpdsi_append_sample(vpds_sampler *s, const double *x, double r, double t, uint8_t flags)
 {
-    vpdsi_kd_samples v;
     memcpy(s->x + s->n * (size_t)s->dim, x, (size_t)s->dim * sizeof(double));
     s->r[s->n] = r;
     s->t[s->n] = t;
     s->flags[s->n] = flags;
     s->n++;
-    v = vpdsi_samples_view(s);
-    vpdsi_kd_insert(&s->tree, &v, (int32_t)(s->n - 1));
+    if (s->grid_mode) {
+        s->grid.cell[vpdsi_bgrid_locate(&s->grid, x)] = (int32_t)(s->n - 1);
+    } else {
+        vpdsi_kd_samples v = vpdsi_samples_view(s);
+        vpdsi_kd_insert(&s->tree, &v, (int32_t)(s->n - 1));
+        s->tree_n = s->n;
+    }
 }
 
 vpds_status vpds_create(const vpds_desc *d, vpds_sampler **out)
@@ -120,6 +136,7 @@ void vpds_destroy(vpds_sampler *s)
     vpdsi_mem m;
     if (!live(s)) return;
     vpdsi_mps_release(s);
+    vpdsi_bgrid_release(&s->grid, &s->mem);
     vpdsi_kd_release(&s->tree, &s->mem);
     vpdsi_mem_free(&s->mem, s->x, s->cap_x * sizeof(double));
     vpdsi_mem_free(&s->mem, s->r, s->cap_r * sizeof(double));
@@ -243,6 +260,12 @@ vpds_status vpds_add_points(vpds_sampler *s, const double *x, const double *r, s
             return VPDS_ERR_INVALID_ARGUMENT;
         }
     }
+    if (s->grid_mode) {
+        /* fixed points may share cells and carry other radii: the kd-tree takes over */
+        if ((st = vpdsi_sync_tree(s)) != VPDS_OK) return st;
+        s->grid_mode = 0;
+        vpdsi_bgrid_release(&s->grid, &s->mem);
+    }
     if ((st = vpdsi_reserve_samples(s, n)) != VPDS_OK) return st;
     if (!r) {
         /* every radius first, so that a bad one leaves the sampler unchanged */
@@ -272,8 +295,10 @@ vpds_status vpds_add_points(vpds_sampler *s, const double *x, const double *r, s
         {
             vpdsi_kd_samples v = vpdsi_samples_view(s);
             vpdsi_kd_insert(&s->tree, &v, (int32_t)at);
+            s->tree_n = s->n;
         }
     }
+    s->n_fixed += n;
     return VPDS_OK;
 }
 

@@ -1,6 +1,7 @@
 /* Private state of a vpds_sampler, shared by the public entry points and the MPS driver. */
 #ifndef VPDS_SAMPLER_H
 #define VPDS_SAMPLER_H
+#include "bgrid.h"
 #include "cells.h"
 #include "kdtree.h"
 #include "rng.h"
@@ -51,7 +52,11 @@ struct vpds_sampler {
     double *r; size_t cap_r;
     double *t; size_t cap_t;
     uint8_t *flags; size_t cap_flags;
-    vpdsi_kdtree tree;
+    size_t n_fixed;
+    vpdsi_kdtree tree;   /* holds samples [0, tree_n); synced before kd-tree queries */
+    size_t tree_n;
+    vpdsi_bgrid grid;    /* the uniform-radius accelerator, in use when grid_mode */
+    int grid_mode;
 
     vpdsi_run run;
     vpds_stats stats;
@@ -66,6 +71,8 @@ struct vpds_sampler {
 void vpdsi_set_error(vpds_sampler *s, const char *fmt, ...);
 /* Room for `more` samples in every per-sample array and the tree; nothing changes on failure. */
 vpds_status vpdsi_reserve_samples(vpds_sampler *s, size_t more);
+/* Insert samples [tree_n, n) into the kd-tree (for leaving grid mode). */
+vpds_status vpdsi_sync_tree(vpds_sampler *s);
 /* Append and index a sample (after vpdsi_reserve_samples). */
 void vpdsi_append_sample(vpds_sampler *s, const double *x, double r, double t, uint8_t flags);
 vpdsi_kd_samples vpdsi_samples_view(const vpds_sampler *s);

@@ -1,0 +1,125 @@
+#include "bgrid.h"
+#include <math.h>
+#include <string.h>
+
+void vpdsi_bgrid_release(vpdsi_bgrid *g, vpdsi_mem *m)
+{
+    vpdsi_mem_free(m, g->cell, g->cap_cell * sizeof *g->cell);
+    vpdsi_mem_free(m, g->stencil, g->cap_stencil * sizeof *g->stencil);
+    memset(g, 0, sizeof *g);
+}
+
+typedef struct {
+    int64_t offset;
+    double d2;
+} stencil_entry;
+
+int vpdsi_bgrid_setup(vpdsi_bgrid *g, vpdsi_mem *m, int dim, const uint64_t *n, const double *lo,
+                      const double *side, double reach)
+{
+    uint64_t total = 1, span = 0;
+    int k, o[VPDS_MAX_DIM];
+    size_t count = 0, i, j, cap_tmp = 0;
+    stencil_entry *tmp = NULL;
+    vpdsi_bgrid_release(g, m);
+    for (k = 0; k < dim; k++) {
+        uint64_t sk = (uint64_t)floor(reach / side[k]) + 1;
+        if (sk > 8) return -1; /* not the grid this path is for */
+        if (sk > span) span = sk;
+    }
+    for (k = 0; k < dim; k++) {
+        g->stride[k] = total;
+        if (n[k] + 2 * span > ((uint64_t)INT32_MAX) / total) return -1;
+        total *= n[k] + 2 * span;
+    }
+    g->dim = dim;
+    g->pad = span;
+    g->origin = 0;
+    for (k = 0; k < dim; k++) {
+        g->n[k] = n[k];
+        g->lo[k] = lo[k];
+        g->side[k] = side[k];
+        g->origin += span * g->stride[k];
+    }
+    /* stencil: offsets whose cells come within reach of the centre cell, with a margin for the
+     * rounding of a point's cell index */
+    for (k = 0; k < dim; k++) o[k] = -(int)span;
+    for (;;) {
+        double d2 = 0;
+        int zero = 1;
+        int64_t off = 0;
+        for (k = 0; k < dim; k++) {
+            int a = o[k] < 0 ? -o[k] : o[k];
+            double gap = a > 1 ? (a - 1) * side[k] : 0;
+            d2 += gap * gap;
+            if (o[k]) zero = 0;
+            off += (int64_t)o[k] * (int64_t)g->stride[k];
+        }
+        if (!zero && d2 < reach * reach * (1 + 1e-6)) {
+            double c2 = 0;
+            if (vpdsi_mem_reserve(m, (void **)&tmp, &cap_tmp, count + 1, sizeof *tmp)) goto oom;
+            for (k = 0; k < dim; k++) c2 += (double)o[k] * o[k] * side[k] * side[k];
+            tmp[count].offset = off;
+            tmp[count].d2 = c2;
+            count++;
+        }
+        for (k = 0; k < dim; k++) {
+            if (++o[k] <= (int)span) break;
+            o[k] = -(int)span;
+        }
+        if (k == dim) break;
+    }
+    /* nearest first, so a conflict is usually found at the first look (insertion sort: small) */
+    for (i = 1; i < count; i++) {
+        stencil_entry e = tmp[i];
+        for (j = i; j > 0 && (tmp[j - 1].d2 > e.d2 || (tmp[j - 1].d2 == e.d2 && tmp[j - 1].offset > e.offset)); j--)
+            tmp[j] = tmp[j - 1];
+        tmp[j] = e;
+    }
+    if (vpdsi_mem_reserve(m, (void **)&g->stencil, &g->cap_stencil, count, sizeof *g->stencil) ||
+        vpdsi_mem_reserve(m, (void **)&g->cell, &g->cap_cell, (size_t)total, sizeof *g->cell))
+        goto oom;
+    for (i = 0; i < count; i++) g->stencil[i] = tmp[i].offset;
+    vpdsi_mem_free(m, tmp, cap_tmp * sizeof *tmp);
+    for (i = 0; i < (size_t)total; i++) g->cell[i] = -1;
+    g->n_stencil = count;
+    g->count = (size_t)total;
+    return 0;
+oom:
+    vpdsi_mem_free(m, tmp, cap_tmp * sizeof *tmp);
+    vpdsi_bgrid_release(g, m);
+    return -1;
+}
+
+uint64_t vpdsi_bgrid_locate(const vpdsi_bgrid *g, const double *x)
+{
+    uint64_t idx = g->origin;
+    int k;
+    for (k = 0; k < g->dim; k++) {
+        double u = floor((x[k] - g->lo[k]) / g->side[k]);
+        uint64_t ck = u <= 0 ? 0 : (uint64_t)u;
+        if (ck >= g->n[k]) ck = g->n[k] - 1;
+        idx += ck * g->stride[k];
+    }
+    return idx;
+}
+
+uint64_t vpdsi_bgrid_index(const vpdsi_bgrid *g, const uint64_t *c)
+{
+    uint64_t idx = g->origin;
+    int k;
+    for (k = 0; k < g->dim; k++) idx += c[k] * g->stride[k];
+    return idx;
+}
+
+size_t vpdsi_bgrid_near(const vpdsi_bgrid *g, uint64_t at, int32_t *out)
+{
+    const int32_t *cell = g->cell + at;
+    size_t found = 0, j;
+    if (cell[0] >= 0) out[found++] = cell[0];
+    for (j = 0; j < g->n_stencil; j++) {
+        int32_t i = cell[g->stencil[j]];
+        if (i >= 0) out[found++] = i;
+    }
+    return found;
+}

@@ -1,0 +1,33 @@
+/* Background grid for a uniform radius (Ebeida et al. 2012): cells of diagonal below the
+ * conflict distance, so a cell holds at most one sample and a query scans a fixed stencil of
+ * cells. Used instead of the kd-tree when every disk has the same radius and d <= 3. A border
+ * of empty cells as wide as the stencil lets every query skip bounds checks. */
+#ifndef VPDS_BGRID_H
+#define VPDS_BGRID_H
+#include "mem.h"
+
+typedef struct vpdsi_bgrid {
+    int dim;
+    uint64_t n[VPDS_MAX_DIM];      /* cells per axis (the base cells of the run) */
+    uint64_t stride[VPDS_MAX_DIM]; /* in the padded array */
+    uint64_t pad;                  /* border width in cells */
+    uint64_t origin;               /* padded index of cell (0, ..., 0) */
+    double lo[VPDS_MAX_DIM], side[VPDS_MAX_DIM];
+    int32_t *cell;                 /* sample index or -1 */
+    size_t cap_cell, count;
+    int64_t *stencil;              /* linear offsets, nearest cells first */
+    size_t n_stencil, cap_stencil;
+} vpdsi_bgrid;
+
+/* Lay out over the base grid and empty it; reach is the conflict distance (>= the diagonal). */
+int vpdsi_bgrid_setup(vpdsi_bgrid *g, vpdsi_mem *m, int dim, const uint64_t *n, const double *lo,
+                      const double *side, double reach);
+void vpdsi_bgrid_release(vpdsi_bgrid *g, vpdsi_mem *m);
+/* Padded index of the cell holding x. */
+uint64_t vpdsi_bgrid_locate(const vpdsi_bgrid *g, const double *x);
+/* Padded index of base cell coordinates c. */
+uint64_t vpdsi_bgrid_index(const vpdsi_bgrid *g, const uint64_t *c);
+/* Samples within reach of the cell at padded index at (its own first), appended to out
+ * (capacity >= 1 + n_stencil). */
+size_t vpdsi_bgrid_near(const vpdsi_bgrid *g, uint64_t at, int32_t *out);
+#endif
