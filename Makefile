@@ -23,7 +23,7 @@ FLANN_TEST := $(BUILD)/tests/flann_kdtree
 SAMPLE_TOOL := $(BUILD)/tests/sample_tool
 SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 
-.PHONY: all test demo deps install clean bench check-c check-flann check-py check-sanitizers
+.PHONY: all test demo deps install clean bench check-c check-flann check-py check-sanitizers check-abi
 all: $(SHARED) $(STATIC) $(BUILD)/vpds.pc
 
 $(BUILD)/obj/%.o: libvpds/%.c $(LIB_HDR)
@@ -66,6 +66,9 @@ check-c: $(TEST_BIN)
 check-flann: $(FLANN_TEST)
 	$(FLANN_TEST)
 
+check-abi: all
+	bash tests/abi_check.sh $(BUILD)
+
 check-py: $(SAMPLE_TOOL)
 	python3 -m pytest -q tests/py
 
@@ -81,12 +84,20 @@ $(DEPS_STAMP): tools/deps.sh tests/requirements.txt
 	@mkdir -p $(BUILD) && touch $@
 
 test: $(DEPS_STAMP)
-	$(MAKE) --no-print-directory all check-c check-flann check-sanitizers check-py
+	$(MAKE) --no-print-directory all check-c check-abi check-flann check-sanitizers check-py
 	@echo "all tests passed"
 
 demo: $(BUILD)/demo/figure1
 	@mkdir -p out
 	$(BUILD)/demo/figure1 out
+
+$(BUILD)/bench/bench: bench/bench.c $(STATIC)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_TEST) -O2 $< -o $@ $(STATIC) -lm
+
+# Speed and memory beside the peers (installed by the script itself); BENCH_ARGS=--quick for a short run.
+bench: $(BUILD)/bench/bench
+	python3 bench/run.py $(BENCH_ARGS)
 
 deps:
 	bash tools/deps.sh
@@ -98,7 +109,8 @@ install: all
 	ln -sf libvpds.so.$(VERSION) $(DESTDIR)$(PREFIX)/lib/libvpds.so.$(SOMAJOR)
 	ln -sf libvpds.so.$(SOMAJOR) $(DESTDIR)$(PREFIX)/lib/libvpds.so
 	install -m 644 $(STATIC) $(DESTDIR)$(PREFIX)/lib/
-	install -m 644 $(BUILD)/vpds.pc $(DESTDIR)$(PREFIX)/lib/pkgconfig/vpds.pc
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' libvpds/vpds.pc.in \
+	  > $(DESTDIR)$(PREFIX)/lib/pkgconfig/vpds.pc
 
 clean:
 	rm -rf $(BUILD)

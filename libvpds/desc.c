@@ -110,8 +110,8 @@ vpds_status vpds_validate(const vpds_desc *d, char *msg, size_t cap)
         REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.lipschitz: coverage * L = %g * %g = %g is at or above "
                "the %s rule's limit %g (Table 1)", d->coverage, L, d->coverage * L,
                vpdsi_rule_name(d->rule == VPDS_RULE_DEFAULT ? VPDS_RULE_SMALLER : d->rule), limit);
-    if (d->weighted)
-        REFUSE(VPDS_ERR_UNSUPPORTED, "desc.weighted: the weighted-bias-free process is not "
-               "supported by this version");
+    if (d->weighted && callback && !(d->radius_min > 0))
+        REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.weighted with a sizing callback needs desc.radius_min "
+               "> 0 (a lower bound of r: darts are kept with probability (radius_min / r)^dim)");
     return VPDS_OK;
 }

@@ -156,8 +156,9 @@ static uint64_t cur_count(const vpds_sampler *s)
     return s->run.implicit ? s->run.base_count : (uint64_t)s->run.cur.count;
 }
 
-/* n darts into out (n*dim): a cell uniformly, then a point uniformly in it. */
-static void draw_darts(const vpds_sampler *s, vpdsi_rng *rng, size_t n, double *out)
+/* n darts into out (n*dim): a cell uniformly, then a point uniformly in it; in weighted mode
+ * one more uniform per dart into u, for its acceptance (Eq. 12). */
+static void draw_darts(const vpds_sampler *s, vpdsi_rng *rng, size_t n, double *out, double *u)
 {
     uint64_t c[VPDS_MAX_DIM], total = cur_count(s);
     double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
@@ -171,6 +172,7 @@ static void draw_darts(const vpds_sampler *s, vpdsi_rng *rng, size_t n, double *
             double v = lo[k] + vpdsi_rng_unit(rng) * (hi[k] - lo[k]);
             out[j * (size_t)d + (size_t)k] = v > hi[k] ? hi[k] : v;
         }
+        if (u) u[j] = vpdsi_rng_unit(rng);
     }
 }
 
@@ -210,6 +212,7 @@ static vpds_status darts_chunk(vpds_sampler *s, size_t n)
 {
     int d = s->dim;
     int varying = s->sizing.kind != VPDSI_SIZING_CONSTANT;
+    int weighted = s->weighted && varying;
     double scale = s->run.t * s->inhibition;
     vpdsi_rng start = s->rng;
     vpdsi_kd_samples view;
@@ -217,7 +220,11 @@ static vpds_status darts_chunk(vpds_sampler *s, size_t n)
     size_t j;
     if ((st = reserve_buffers(s, n)) != VPDS_OK) return st;
     if ((st = vpdsi_reserve_samples(s, n)) != VPDS_OK) return st;
-    draw_darts(s, &s->rng, n, s->buf_x);
+    if (weighted && vpdsi_mem_reserve(&s->mem, (void **)&s->buf_u, &s->cap_buf_u, n, sizeof(double))) {
+        vpdsi_set_error(s, "out of memory for a chunk of %zu darts", n);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    draw_darts(s, &s->rng, n, s->buf_x, weighted ? s->buf_u : NULL);
     if (varying) {
         st = vpdsi_sizing_eval(&s->sizing, s->buf_x, n, s->buf_r, s->err, sizeof s->err);
         if (st != VPDS_OK) {
@@ -227,9 +234,30 @@ static vpds_status darts_chunk(vpds_sampler *s, size_t n)
     } else {
         for (j = 0; j < n; j++) s->buf_r[j] = s->sizing.radius;
     }
+    if (weighted) {
+        /* Eq. 12 by rejection: keep a dart with probability (r_min / r(y))^d, so accepted darts
+         * have density proportional to 1 / r^d over the free region */
+        for (j = 0; j < n; j++) {
+            if (s->buf_r[j] < s->sizing.rmin) {
+                char py[256];
+                vpdsi_format_point(py, sizeof py, s->buf_x + j * (size_t)d, d);
+                vpdsi_set_error(s, "sizing returned r = %.17g at x = (%s), below radius_min = %.17g",
+                                s->buf_r[j], py, s->sizing.rmin);
+                s->rng = start;
+                return VPDS_ERR_SIZING;
+            }
+            {
+                double ratio = s->sizing.rmin / s->buf_r[j], keep = 1;
+                int k;
+                for (k = 0; k < d; k++) keep *= ratio;
+                s->buf_u[j] = s->buf_u[j] < keep ? 1.0 : 0.0;
+            }
+        }
+    }
     for (j = 0; j < n; j++) {
         const double *y = s->buf_x + j * (size_t)d;
         int32_t witness = -1, hit;
+        if (weighted && s->buf_u[j] == 0.0) continue;
         if (s->grid_mode) {
             hit = grid_conflict(s, y, scale * s->sizing.radius);
         } else {
@@ -252,7 +280,7 @@ static vpds_status darts_chunk(vpds_sampler *s, size_t n)
                             fabs(s->buf_r[j] - s->r[witness]) / dist);
             /* keep the darts before this one, as a pause would */
             s->rng = start;
-            draw_darts(s, &s->rng, j, s->buf_x);
+            draw_darts(s, &s->rng, j, s->buf_x, weighted ? s->buf_u : NULL);
             s->run.darts_left -= j;
             s->stats.darts += j;
             return VPDS_ERR_LIPSCHITZ;

@@ -145,6 +145,7 @@ void vpds_destroy(vpds_sampler *s)
     vpdsi_mem_free(&s->mem, s->cand, s->cap_cand * sizeof(int32_t));
     vpdsi_mem_free(&s->mem, s->buf_x, s->cap_buf_x * sizeof(double));
     vpdsi_mem_free(&s->mem, s->buf_r, s->cap_buf_r * sizeof(double));
+    vpdsi_mem_free(&s->mem, s->buf_u, s->cap_buf_u * sizeof(double));
     if (s->sizing.grid) vpds_grid_destroy(s->sizing.grid);
     m = s->mem;
     s->magic = 0;
@@ -158,20 +159,50 @@ const char *vpds_last_error(const vpds_sampler *s)
     return s->err;
 }
 
-/* Unknown r_max with a callback: bound it from the centre's radius and L. */
+/* Unknown r_max with a callback: it only sizes the base cells of the kd-tree path (never a
+ * correctness bound there), so estimate it from r on a lattice of up to 4096 points, capped by
+ * the bound that L gives from the box's centre. */
 static vpds_status ensure_rmax(vpds_sampler *s)
 {
-    double c[VPDS_MAX_DIM] = {0}, rc, diag2 = 0;
-    int k;
+    double c[VPDS_MAX_DIM] = {0}, rc, diag2 = 0, best = 0, *pts = NULL;
+    int k, d = s->dim, per = 2;
+    size_t n = 1, i, cap = 0;
     vpds_status st;
     if (s->sizing.rmax > 0) return VPDS_OK;
-    for (k = 0; k < s->dim; k++) {
+    for (k = 0; k < d; k++) {
         c[k] = 0.5 * (s->lo[k] + s->hi[k]);
         diag2 += (s->hi[k] - s->lo[k]) * (s->hi[k] - s->lo[k]);
     }
     st = vpdsi_sizing_eval(&s->sizing, c, 1, &rc, s->err, sizeof s->err);
     if (st != VPDS_OK) return st;
-    s->sizing.rmax = rc + s->sizing.lipschitz * sqrt(diag2) / 2;
+    while (per < 64 && n * (size_t)(per + 1) <= 4096) {
+        per++;
+        for (n = 1, k = 0; k < d; k++) n *= (size_t)per;
+    }
+    for (n = 1, k = 0; k < d; k++) n *= (size_t)per;
+    if (vpdsi_mem_reserve(&s->mem, (void **)&pts, &cap, n * (size_t)d, sizeof(double)) ||
+        vpdsi_mem_reserve(&s->mem, (void **)&s->buf_r, &s->cap_buf_r, n, sizeof(double))) {
+        vpdsi_mem_free(&s->mem, pts, cap * sizeof(double));
+        vpdsi_set_error(s, "out of memory estimating the largest radius");
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < n; i++) {
+        size_t rest = i;
+        for (k = 0; k < d; k++) {
+            size_t j = rest % (size_t)per;
+            rest /= (size_t)per;
+            pts[i * (size_t)d + (size_t)k] =
+                s->lo[k] + (s->hi[k] - s->lo[k]) * (double)j / (double)(per - 1);
+        }
+    }
+    st = vpdsi_sizing_eval(&s->sizing, pts, n, s->buf_r, s->err, sizeof s->err);
+    vpdsi_mem_free(&s->mem, pts, cap * sizeof(double));
+    if (st != VPDS_OK) return st;
+    for (i = 0; i < n; i++)
+        if (s->buf_r[i] > best) best = s->buf_r[i];
+    if (rc > best) best = rc;
+    s->sizing.rmax = best;
+    if (rc + s->sizing.lipschitz * sqrt(diag2) / 2 < best) s->sizing.rmax = rc + s->sizing.lipschitz * sqrt(diag2) / 2;
     return VPDS_OK;
 }
 

@@ -65,6 +65,7 @@ struct vpds_sampler {
     int32_t *cand; size_t n_cand, cap_cand;
     double *buf_x; size_t cap_buf_x;
     double *buf_r; size_t cap_buf_r;
+    double *buf_u; size_t cap_buf_u; /* weighted mode: the acceptance draw of each dart */
     char err[512];
 };
 

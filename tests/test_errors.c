@@ -80,7 +80,13 @@ int main(void)
     d.inhibition = NAN; refused(&d, "desc.inhibition = nan", VPDS_ERR_INVALID_ARGUMENT);
     d = vpds_default_desc(); d.coverage = 0; refused(&d, "desc.coverage = 0", VPDS_ERR_INVALID_ARGUMENT);
     d = vpds_default_desc(); d.inhibition = 0.5; refused(&d, "two radii", VPDS_ERR_UNSUPPORTED);
-    d = vpds_default_desc(); d.weighted = 1; refused(&d, "weighted", VPDS_ERR_UNSUPPORTED);
+    d = vpds_default_desc(); d.weighted = 1; d.sizing = ramp; d.lipschitz = 0.3;
+    refused(&d, "desc.weighted with a sizing callback needs desc.radius_min", VPDS_ERR_INVALID_ARGUMENT);
+    /* weighted: a callback going below the declared radius_min is caught */
+    d.radius_min = 0.1; d.seed = 2;
+    CHECK(vpds_create(&d, &s) == VPDS_OK);
+    CHECK(vpds_run(s) == VPDS_ERR_SIZING && strstr(vpds_last_error(s), "below radius_min = 0.1"));
+    vpds_destroy(s);
     d = vpds_default_desc(); d.domain = (vpds_domain_fn)ramp; refused(&d, "desc.domain", VPDS_ERR_UNSUPPORTED);
     d = vpds_default_desc(); d.radius_min = -1; refused(&d, "desc.radius_min = -1", VPDS_ERR_INVALID_ARGUMENT);
     d = vpds_default_desc(); d.radius_max = NAN; refused(&d, "desc.radius_max = nan", VPDS_ERR_INVALID_ARGUMENT);

@@ -44,6 +44,8 @@ def sizing_named(name: str, radius: float = 0.0) -> Sizing:
         return Sizing(lambda y: np.full(len(y), radius), 0.0)
     if name == "ramp":  # the paper's Figure 1
         return Sizing(lambda y: 0.001 + 0.3 * y[:, 0], 0.3)
+    if name == "mild":  # a gentle ramp, for the weighted process
+        return Sizing(lambda y: 0.04 + 0.04 * y[:, 0], 0.04)
     if name == "radial":  # the paper's Figure 10
         def radial(y: np.ndarray) -> np.ndarray:
             d = np.sqrt(((y - 0.5) ** 2).sum(axis=1))

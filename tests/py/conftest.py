@@ -18,10 +18,10 @@ def sample(tmp_path_factory):
 
     out_dir = tmp_path_factory.mktemp("samples")
 
-    def run(dim, rule, sizing, radius, seed, lo, hi, budget=0):
-        path = out_dir / f"{dim}-{rule}-{sizing}-{radius}-{seed}-{lo}-{hi}-{budget}.bin"
+    def run(dim, rule, sizing, radius, seed, lo, hi, budget=0, weighted=0):
+        path = out_dir / f"{dim}-{rule}-{sizing}-{radius}-{seed}-{lo}-{hi}-{budget}-{weighted}.bin"
         cmd = [str(TOOL), str(path), str(dim), rule, sizing, repr(radius), str(seed), repr(lo),
-               repr(hi), str(budget)]
+               repr(hi), str(budget), str(weighted)]
         subprocess.run(cmd, check=True, capture_output=True, text=True)
         return checker.load(str(path))
 

@@ -40,14 +40,18 @@ def free_mask(prefix, r_prefix, rule, sizing, lo, hi, L):
     return pts, free
 
 
-def ranks(pts, free, prefix, y):
+def ranks(pts, free, prefix, y, weight=None):
+    """Ranks of y among the free pixels by x, y and distance to the nearest sample; with a
+    weight per pixel, weighted ranks (the law of Eq. 12 instead of Eq. 4)."""
     fp = pts[free]
-    out = [np.mean(fp[:, 0] < y[0]), np.mean(fp[:, 1] < y[1])]
+    w = np.ones(len(fp)) if weight is None else weight[free]
+    w = w / w.sum()
+    out = [w[fp[:, 0] < y[0]].sum(), w[fp[:, 1] < y[1]].sum()]
     if len(prefix):
         tree = cKDTree(prefix)
         dfree, _ = tree.query(fp)
         dy, _ = tree.query(y)
-        out.append(np.mean(dfree < dy))
+        out.append(w[dfree < dy].sum())
     else:
         out.append(np.nan)
     return out
@@ -94,3 +98,27 @@ def test_bias_free(sample, rule, sizing_name, radius, lo, hi):
     print(f"{rule}/{sizing_name}: KS p-values ours {p_ours}, Bridson {p_biased}")
     assert min(p_ours) > 1e-3, p_ours
     assert min(p_biased) < 1e-3, p_biased  # the same level rejects the biased variant
+
+
+def test_weighted_bias_free(sample):
+    """Eq. 12: with `weighted`, sample k+1 has density 1/r^2 over the free region. The weighted
+    process passes the weighted ranks; the plain process (uniform over the free region) fails
+    them, so the test tells the two laws apart."""
+    sizing = C.sizing_named("mild")
+    rng = np.random.default_rng(3)
+    p = {}
+    for weighted in (1, 0):
+        got = []
+        for seed in range(RUNS):
+            x, r, _ = sample(2, "smaller", "mild", 0.0, 5000 + seed, 0.0, 1.0, 0, weighted)
+            k = int(rng.integers(1, len(x)))
+            pts, free = free_mask(x[:k], r[:k], "smaller", sizing, 0.0, 1.0, sizing.lipschitz)
+            if free.sum() < 20:
+                continue
+            got.append(ranks(pts, free, x[:k], x[k], weight=sizing.fn(pts) ** -2.0))
+        got = np.array(got)
+        p[weighted] = [stats.kstest(got[:, j][~np.isnan(got[:, j])], "uniform").pvalue
+                       for j in range(3)]
+    print(f"weighted ranks: KS p-values weighted process {p[1]}, plain process {p[0]}")
+    assert min(p[1]) > 1e-3, p[1]
+    assert min(p[0]) < 1e-3, p[0]

@@ -45,6 +45,13 @@ def test_radial_figure10(sample, rule, dim, lo, hi):
 
 
 @pytest.mark.parametrize("rule", C.RULES)
+def test_weighted_process_is_valid(sample, rule):
+    """Eq. 12's process changes where samples go, not the empty-disk or maximality promises."""
+    x, r, _ = sample(2, rule, "mild", 0.0, 4, 0.0, 1.0, 0, 1)
+    assert_valid(x, r, rule, C.sizing_named("mild"), 0.0, 1.0)
+
+
+@pytest.mark.parametrize("rule", C.RULES)
 @pytest.mark.parametrize("sizing_name,lo,hi", [("ramp", 0.0, 1.0), ("radial", 0.4, 0.6)])
 def test_table1_delaunay_bounds(sample, rule, sizing_name, lo, hi):
     x, r, _ = sample(2, rule, sizing_name, 0.0, 3, lo, hi)

@@ -1,7 +1,8 @@
 /* Samples one named configuration and writes it for the independent checkers in tests/py:
  * int64 n, int64 dim, then n*dim doubles x, n radii, n scales t.
- * usage: sample_tool OUT dim rule sizing radius seed lo hi [budget]
- *   rule: prior|current|bigger|smaller; sizing: const|ramp|radial (the paper's Figures 1, 10) */
+ * usage: sample_tool OUT dim rule sizing radius seed lo hi [budget [weighted]]
+ *   rule: prior|current|bigger|smaller; sizing: const|ramp|radial (the paper's Figures 1, 10)
+ *   or mild (0.04 + 0.04 x); weighted: 1 for the weighted-bias-free process (Eq. 12) */
 #include "vpds.h"
 #include <math.h>
 #include <stdio.h>
@@ -9,6 +10,7 @@
 #include <string.h>
 
 static double ramp(const double *x, void *u) { (void)u; return 0.001 + 0.3 * x[0]; }
+static double mild(const double *x, void *u) { (void)u; return 0.04 + 0.04 * x[0]; }
 static double radial(const double *x, void *u)
 {
     int dim = *(int *)u, k;
@@ -47,6 +49,10 @@ int main(int argc, char **argv)
     if (!strcmp(argv[4], "ramp")) {
         d.sizing = ramp;
         d.lipschitz = 0.3;
+    } else if (!strcmp(argv[4], "mild")) {
+        d.sizing = mild;
+        d.lipschitz = 0.04;
+        d.radius_min = 0.04;
     } else if (!strcmp(argv[4], "radial")) {
         d.sizing = radial;
         d.sizing_user = &dim;
@@ -54,6 +60,7 @@ int main(int argc, char **argv)
     }
     d.seed = strtoull(argv[6], NULL, 10);
     if (argc > 9) d.budget = strtoull(argv[9], NULL, 10);
+    if (argc > 10) d.weighted = atoi(argv[10]);
     if ((st = vpds_create(&d, &s)) != VPDS_OK) {
         char msg[512];
         vpds_validate(&d, msg, sizeof msg);

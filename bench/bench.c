@@ -1,0 +1,75 @@
+#define _POSIX_C_SOURCE 199309L
+/* libvpds workloads for `make bench`. Prints "name n seconds peak_bytes" per line.
+ * usage: bench uniform DIM RADIUS | ramp RULE | floor N DIM | grid2d RADIUS */
+#include "rng.h"
+#include "vpds.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static double ramp(const double *x, void *u) { (void)u; return 0.001 + 0.3 * x[0]; }
+
+static int run(const char *name, vpds_desc *d)
+{
+    vpds_sampler *s;
+    vpds_status st;
+    double t0;
+    vpds_stats stats;
+    if (vpds_create(d, &s) != VPDS_OK) return 1;
+    t0 = now();
+    st = vpds_run(s);
+    if (st != VPDS_OK) {
+        fprintf(stderr, "%s: %s\n", name, vpds_last_error(s));
+        return 1;
+    }
+    stats = vpds_get_stats(s);
+    printf("%s %zu %.6f %zu\n", name, vpds_count(s), now() - t0, stats.peak_bytes);
+    vpds_destroy(s);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    vpds_desc d = vpds_default_desc();
+    d.seed = 1;
+    if (argc >= 4 && !strcmp(argv[1], "uniform")) {
+        d.dim = atoi(argv[2]);
+        d.radius = atof(argv[3]);
+        return run("uniform", &d);
+    }
+    if (argc >= 3 && !strcmp(argv[1], "ramp")) {
+        /* the paper's Figure 1 ramp on a box 400 times taller: about a million samples */
+        double lo[2] = {0, 0}, hi[2] = {1, 400};
+        d.lo = lo;
+        d.hi = hi;
+        d.sizing = ramp;
+        d.lipschitz = 0.3;
+        d.rule = !strcmp(argv[2], "prior") ? VPDS_RULE_PRIOR : !strcmp(argv[2], "current") ? VPDS_RULE_CURRENT
+                 : !strcmp(argv[2], "bigger") ? VPDS_RULE_BIGGER : VPDS_RULE_SMALLER;
+        return run(argv[2], &d);
+    }
+    if (argc >= 4 && !strcmp(argv[1], "floor")) {
+        /* the floor: as many uniform random points with the library's own generator */
+        size_t n = (size_t)atof(argv[2]), i, dim = (size_t)atoi(argv[3]);
+        double *x = (double *)malloc(n * dim * sizeof(double)), t0, sum = 0;
+        vpdsi_rng r;
+        vpdsi_rng_seed(&r, 1);
+        t0 = now();
+        for (i = 0; i < n * dim; i++) x[i] = vpdsi_rng_unit(&r);
+        t0 = now() - t0;
+        for (i = 0; i < n * dim; i += 4096) sum += x[i];
+        printf("floor %zu %.6f %zu\n", n, t0 + 0 * sum, n * dim * sizeof(double));
+        free(x);
+        return 0;
+    }
+    fprintf(stderr, "usage: bench uniform DIM RADIUS | ramp RULE | floor N DIM\n");
+    return 2;
+}

@@ -1,0 +1,134 @@
+"""`make bench`: libvpds beside its peers on the same workloads, as ratios, in one run.
+
+Peers come from the registries and are installed here, into build/bench: scipy's
+qmc.PoissonDisk (PyPI), the npm package poisson-disk-sampling, the Rust crate fast_poisson.
+None of them is maximal; all are Bridson-style (biased) samplers. The floor is drawing the same
+number of uniform random points with libvpds's own generator. Times are wall-clock seconds of
+one run on this machine, one core.
+"""
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+OUT = ROOT / "build" / "bench"
+QUICK = "--quick" in sys.argv
+
+
+def sh(cmd, **kw):
+    return subprocess.run(cmd, check=True, capture_output=True, text=True, **kw).stdout
+
+
+def install_peers() -> dict[str, object]:
+    peers: dict[str, object] = {}
+    OUT.mkdir(parents=True, exist_ok=True)
+    try:
+        sh([sys.executable, "-m", "pip", "install", "-q", "--disable-pip-version-check", "scipy"])
+        peers["scipy"] = True
+    except Exception as e:  # noqa: BLE001
+        print("scipy unavailable:", e)
+    node_dir = OUT / "node"
+    try:
+        node_dir.mkdir(exist_ok=True)
+        for f in ("package.json", "peer.js"):
+            shutil.copy(ROOT / "bench" / "peers" / "node" / f, node_dir / f)
+        sh(["npm", "install", "--no-audit", "--no-fund", "--silent"], cwd=node_dir)
+        peers["npm"] = node_dir / "peer.js"
+    except Exception as e:  # noqa: BLE001
+        print("npm peer unavailable:", e)
+    cargo = shutil.which("cargo") or str(Path.home() / ".cargo" / "bin" / "cargo")
+    try:
+        env = dict(os.environ, CARGO_TARGET_DIR=str(OUT / "rust"))
+        sh([cargo, "build", "--release", "-q"], cwd=ROOT / "bench" / "peers" / "rust", env=env)
+        peers["rust"] = OUT / "rust" / "release" / "vpds-bench-fast-poisson"
+    except Exception as e:  # noqa: BLE001
+        print("fast_poisson unavailable:", e)
+    return peers
+
+
+def vpds(*args) -> tuple[int, float, int]:
+    out = sh([str(OUT / "bench"), *map(str, args)]).split()
+    return int(out[1]), float(out[2]), int(out[3])
+
+
+def radius_for(n: float, dim: int) -> float:
+    """Radius of a maximal uniform set of about n points in [0,1]^dim (measured densities)."""
+    density = {2: 0.697, 3: 95396 * 0.02 ** 3, 6: 663 * 0.45 ** 6}[dim]
+    return (density / n) ** (1.0 / dim)
+
+
+def main() -> None:
+    peers = install_peers()
+    rows = []
+
+    def row(name, n, sec, mem=None, note=""):
+        rows.append((name, n, sec, mem, note))
+        per = f"{n / sec:,.0f}/s" if sec > 0 else "-"
+        print(f"{name:44s} n={n:>10,d}  {sec:9.3f} s  {per:>14s}  "
+              f"{'' if mem is None else f'{mem / n:6.1f} B/sample'}  {note}", flush=True)
+
+    # 2D uniform, about a million samples (fewer with --quick)
+    n_target = 1e5 if QUICK else 1e6
+    r = radius_for(n_target, 2)
+    n, sec, mem = vpds("uniform", 2, r)
+    row(f"libvpds 2D uniform r={r:.6f} (maximal)", n, sec, mem)
+    base_rate = n / sec
+    fn, fsec, _ = vpds("floor", n, 2)
+    row("floor: same count of uniform points", fn, fsec, note=f"libvpds is {sec / fsec:.0f}x the floor")
+    if "npm" in peers:
+        out = sh(["node", str(peers["npm"]), repr(r), "1"]).split()
+        pn, ps = int(out[0]), float(out[1])
+        row("npm poisson-disk-sampling (not maximal)", pn, ps,
+            note=f"libvpds/peer samples-per-second: {base_rate / (pn / ps):.2f}")
+    if "rust" in peers:
+        out = sh([str(peers["rust"]), "2", repr(r), "1"]).split()
+        pn, ps = int(out[0]), float(out[1])
+        row("crate fast_poisson (not maximal)", pn, ps,
+            note=f"libvpds/peer samples-per-second: {base_rate / (pn / ps):.2f}")
+    if "scipy" in peers:
+        # scipy is too slow for a million: compare on a smaller workload, both sides
+        rs = radius_for(2e4, 2)
+        from scipy.stats import qmc
+        t0 = time.perf_counter()
+        pts = qmc.PoissonDisk(2, radius=rs, rng=1).fill_space()
+        ss = time.perf_counter() - t0
+        vn, vs, _ = vpds("uniform", 2, rs)
+        row(f"libvpds 2D uniform r={rs:.5f}", vn, vs)
+        row("scipy qmc.PoissonDisk.fill_space (not maximal)", len(pts), ss,
+            note=f"libvpds/peer samples-per-second: {(vn / vs) / (len(pts) / ss):.1f}")
+
+    # variable radii: the paper's ramp, each rule, beside the uniform time per sample
+    for rule in ("prior", "current", "bigger", "smaller"):
+        n, sec, mem = vpds("ramp", rule)
+        row(f"libvpds ramp 0.001+0.3x on 1x400, {rule}", n, sec, mem,
+            note=f"time/sample = {(sec / n) * base_rate:.2f}x uniform")
+
+    # growth of time per sample with n
+    sizes = [1e4, 1e5, 1e6] if QUICK else [1e4, 1e5, 1e6, 1e7]
+    per = []
+    for target in sizes:
+        n, sec, mem = vpds("uniform", 2, radius_for(target, 2))
+        per.append(sec / n)
+        row(f"libvpds 2D uniform, n ~ {target:.0e}", n, sec, mem,
+            note=f"time/sample = {per[-1] / per[0]:.2f}x that at 1e4")
+
+    # 3D and 6D uniform
+    n, sec, mem = vpds("uniform", 3, radius_for(1e5 if QUICK else 1e6, 3))
+    row("libvpds 3D uniform", n, sec, mem)
+    if "rust" in peers and not QUICK:
+        out = sh([str(peers["rust"]), "3", repr(radius_for(1e5, 3)), "1"]).split()
+        vn, vs, _ = vpds("uniform", 3, radius_for(1e5, 3))
+        row("libvpds 3D uniform (1e5)", vn, vs)
+        row("crate fast_poisson 3D (1e5)", int(out[0]), float(out[1]),
+            note=f"libvpds/peer samples-per-second: {(vn / vs) / (int(out[0]) / float(out[1])):.2f}")
+    n, sec, mem = vpds("uniform", 6, radius_for(1e4 if QUICK else 1e5, 6))
+    row("libvpds 6D uniform (maximal)", n, sec, mem)
+
+
+if __name__ == "__main__":
+    main()
