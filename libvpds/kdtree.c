@@ -158,20 +158,6 @@ double vpdsi_box_maxdist2(const double *p, const double *lo, const double *hi, i
     return s;
 }
 
-static double box_box_mindist2(const double *alo, const double *ahi, const double *blo,
-                               const double *bhi, int dim)
-{
-    double s = 0;
-    int k;
-    for (k = 0; k < dim; k++) {
-        double e = 0;
-        if (ahi[k] < blo[k]) e = blo[k] - ahi[k];
-        else if (bhi[k] < alo[k]) e = alo[k] - bhi[k];
-        s += e * e;
-    }
-    return s;
-}
-
 static double dist2(const double *a, const double *b, int dim)
 {
     double s = 0;
@@ -227,26 +213,56 @@ static int push_index(vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap, i
     return 0;
 }
 
+/* Lower bound of the farthest distance, along one axis, from a point of [a, b] to the nearest
+ * sub-interval (centres c0, c1 of half-width w). */
+static double far_bound(double a, double b, double c0, double c1, double w)
+{
+    double g0 = c0 < a ? a - c0 : c0 > b ? c0 - b : 0;
+    double g1 = c1 < a ? a - c1 : c1 > b ? c1 - b : 0;
+    return w + (g0 < g1 ? g0 : g1);
+}
+
 int vpdsi_kd_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *lo,
-                    const double *hi, double r_hi, int rule, double scale, double min_reach,
+                    const double *hi, double r_hi, int rule, double scale, int split,
                     vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap)
 {
     int32_t stack[STACK_MAX];
-    int top = 0, d = t->dim;
+    int top = 0, d = t->dim, k;
+    double c0[VPDS_MAX_DIM], c1[VPDS_MAX_DIM], w[VPDS_MAX_DIM];
     if (t->n_nodes == 0) return 0;
+    for (k = 0; k < d; k++) {
+        double mid = 0.5 * (lo[k] + hi[k]);
+        if (split) {
+            c0[k] = 0.5 * (lo[k] + mid);
+            c1[k] = 0.5 * (mid + hi[k]);
+            w[k] = 0.25 * (hi[k] - lo[k]);
+        } else {
+            c0[k] = c1[k] = mid;
+            w[k] = 0.5 * (hi[k] - lo[k]);
+        }
+    }
     stack[top++] = 0;
     while (top > 0) {
         int32_t n = stack[--top];
         const vpdsi_kd_node *nd = &t->nodes[n];
-        double reach = scale * vpdsi_rule_f((vpds_rule)rule, nd->rmax, r_hi);
-        if (reach < min_reach) continue;
-        if (box_box_mindist2(lo, hi, BOX_LO(t, n), BOX_HI(t, n), d) > reach * reach) continue;
+        const double *blo = BOX_LO(t, n), *bhi = BOX_HI(t, n);
+        double reach = scale * vpdsi_rule_f((vpds_rule)rule, nd->rmax, r_hi), need = 0;
+        for (k = 0; k < d; k++) {
+            double f = far_bound(blo[k], bhi[k], c0[k], c1[k], w[k]);
+            need += f * f;
+        }
+        if (need > reach * reach) continue;
         if (nd->left < 0) {
             int32_t i;
             for (i = nd->head; i >= 0; i = t->next[i]) {
+                const double *x = s->x + (size_t)i * d;
                 double f = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_hi);
-                if (f < min_reach) continue;
-                if (vpdsi_box_mindist2(s->x + (size_t)i * d, lo, hi, d) > f * f) continue;
+                need = 0;
+                for (k = 0; k < d; k++) {
+                    double fb = far_bound(x[k], x[k], c0[k], c1[k], w[k]);
+                    need += fb * fb;
+                }
+                if (need > f * f) continue;
                 if (push_index(m, out, count, cap, i)) return -1;
             }
         } else {

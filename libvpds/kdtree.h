@@ -58,11 +58,13 @@ size_t vpdsi_kd_bytes(const vpdsi_kdtree *t);
 int32_t vpdsi_kd_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *y,
                           double ry, int rule, double scale, double lipschitz, int32_t *witness);
 
-/* Samples that might cover a whole sub-box of reach at least min_reach inside the box
- * [lo, hi]: |x - box| <= scale * f(r(x), r_hi) and scale * f(r(x), r_hi) >= min_reach, where r_hi
- * bounds r over the box from above. Appends indices to *out (grown with m); -1 on OOM. */
+/* Samples that might cover a whole sub-box of the box [lo, hi]: its 2^d children when split, else
+ * the box itself; r_hi bounds r over the box from above. A sample's farthest distance to a
+ * sub-box is, along each axis, at least half the sub-box's side plus its distance to the nearest
+ * sub-box centre; summed over axes this bound prunes whole subtrees (with their largest radius)
+ * and single samples. Appends indices to *out (grown with m); -1 on OOM. */
 int vpdsi_kd_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *lo,
-                    const double *hi, double r_hi, int rule, double scale, double min_reach,
+                    const double *hi, double r_hi, int rule, double scale, int split,
                     vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap);
 
 /* BiX (prior) / XiB (current) and their combinations, on candidates from vpdsi_kd_gather:

@@ -302,6 +302,46 @@ static int box_covered(const vpds_sampler *s, const double *lo, const double *hi
     return vpdsi_kd_box_covered(&view, s->dim, s->cand, s->n_cand, lo, hi, r_lo, (int)s->rule, scale);
 }
 
+/* Which of the 2^d children of cell c are covered whole by one candidate. A child's farthest
+ * point from x is, on each axis, the farther end of its half; so per candidate all children's
+ * squared farthest distances are sums of 2 values per axis, built child by child from a
+ * neighbour that differs in one axis. Bit b of covered is child b (bit k: upper half on axis k). */
+static void children_covered(const vpds_sampler *s, unsigned level, const uint64_t *c, double r_lo,
+                             double scale, uint64_t *covered)
+{
+    int d = s->dim, k;
+    unsigned children = 1u << d, b;
+    double lo[VPDS_MAX_DIM], mid[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], sums[1u << VPDS_MAX_DIM];
+    uint64_t cc[VPDS_MAX_DIM];
+    size_t j;
+    for (k = 0; k < d; k++) cc[k] = 2 * c[k];
+    cell_box(s, level + 1, cc, lo, mid);
+    for (k = 0; k < d; k++) cc[k] = 2 * c[k] + 1;
+    cell_box(s, level + 1, cc, mid, hi);
+    for (j = 0; j < s->n_cand; j++) {
+        const double *x = s->x + (size_t)s->cand[j] * (size_t)d;
+        double f = scale * vpdsi_rule_f(s->rule, s->r[s->cand[j]], r_lo), f2 = f * f;
+        double far[VPDS_MAX_DIM][2], least = 0;
+        if (!(f > 0)) continue;
+        for (k = 0; k < d; k++) {
+            double a = fabs(x[k] - lo[k]), m = fabs(x[k] - mid[k]), z = fabs(x[k] - hi[k]);
+            far[k][0] = (a > m ? a : m) * (a > m ? a : m);
+            far[k][1] = (m > z ? m : z) * (m > z ? m : z);
+            least += far[k][0] < far[k][1] ? far[k][0] : far[k][1];
+        }
+        if (least > f2) continue; /* covers no child */
+        sums[0] = 0;
+        for (k = 0; k < d; k++) sums[0] += far[k][0];
+        if (sums[0] <= f2) covered[0] |= 1u;
+        for (b = 1; b < children; b++) {
+            unsigned low = 0;
+            while (!((b >> low) & 1u)) low++;
+            sums[b] = sums[b & (b - 1)] - far[low][0] + far[low][1];
+            if (sums[b] <= f2) covered[b >> 6] |= UINT64_C(1) << (b & 63u);
+        }
+    }
+}
+
 /* Sweep n cells from run->pos: drop covered ones, keep the others (split: their uncovered
  * children) in run->next. run->pos advances cell by cell, so an error mid-chunk loses nothing. */
 static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
@@ -312,7 +352,7 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
     int need_r = vpdsi_rule_uses_y(s->rule) && s->sizing.kind != VPDSI_SIZING_CONSTANT;
     double scale = run->t * s->coverage, L = s->sizing.lipschitz;
     uint64_t c[VPDS_MAX_DIM], cc[VPDS_MAX_DIM];
-    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], clo[VPDS_MAX_DIM], chi[VPDS_MAX_DIM];
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
     size_t j, need;
     vpds_status st;
     if (vpdsi_mul_size(n, children, &need) ||
@@ -344,8 +384,8 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
             uint64_t base[VPDS_MAX_DIM];
             for (k = 0; k < d; k++) base[k] = c[k] >> level; /* the base cell holding this one */
             s->n_cand = vpdsi_bgrid_near(&s->grid, vpdsi_bgrid_index(&s->grid, base), s->cand);
-        } else if (vpdsi_kd_gather(&s->tree, &view, lo, hi, r_hi, (int)s->rule, scale,
-                            split ? h / 4 : h / 2, &s->mem, &s->cand, &s->n_cand, &s->cap_cand)) {
+        } else if (vpdsi_kd_gather(&s->tree, &view, lo, hi, r_hi, (int)s->rule, scale, split,
+                                   &s->mem, &s->cand, &s->n_cand, &s->cap_cand)) {
             vpdsi_set_error(s, "out of memory gathering the samples near a cell");
             return VPDS_ERR_OUT_OF_MEMORY;
         }
@@ -355,10 +395,14 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
             vpdsi_cells_push(&run->next, d, c);
             continue;
         }
-        for (b = 0; b < children; b++) {
-            for (k = 0; k < d; k++) cc[k] = 2 * c[k] + ((b >> k) & 1u);
-            cell_box(s, level + 1, cc, clo, chi);
-            if (!box_covered(s, clo, chi, r_lo, scale)) vpdsi_cells_push(&run->next, d, cc);
+        {
+            uint64_t covered[4] = {0, 0, 0, 0};
+            children_covered(s, level, c, r_lo, scale, covered);
+            for (b = 0; b < children; b++) {
+                if (covered[b >> 6] >> (b & 63u) & 1u) continue;
+                for (k = 0; k < d; k++) cc[k] = 2 * c[k] + ((b >> k) & 1u);
+                vpdsi_cells_push(&run->next, d, cc);
+            }
         }
     }
     return VPDS_OK;

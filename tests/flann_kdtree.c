@@ -129,7 +129,7 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
             for (rule = VPDS_RULE_PRIOR; rule <= VPDS_RULE_SMALLER; rule++) {
                 int ours, ref = 0, ambiguous = 0;
                 cnt = 0;
-                CHECK(vpdsi_kd_gather(&t, &s, lo, hi, rp, rule, 1.0, 0.0, &m, &out, &cnt, &cap) == 0);
+                CHECK(vpdsi_kd_gather(&t, &s, lo, hi, rp, rule, 1.0, 0, &m, &out, &cnt, &cap) == 0);
                 ours = vpdsi_kd_box_covered(&s, dim, out, cnt, lo, hi, rp, rule, 1.0);
                 for (j = 0; j < nf; j++) {
                     int id = f.idx[j];
