@@ -23,7 +23,14 @@ FLANN_TEST := $(BUILD)/tests/flann_kdtree
 SAMPLE_TOOL := $(BUILD)/tests/sample_tool
 SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 
-.PHONY: all test demo deps install clean bench check-c check-flann check-py check-sanitizers check-abi
+FUZZERS := run grid sequence sizing
+FUZZ_SECONDS ?= 120
+FUZZ_TEST_SECONDS ?= 30
+FUZZ_FLAGS := -g -O1 -std=c99 -Iinclude -ffp-contract=off -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all
+VALGRIND := valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect
+
+.PHONY: all test demo deps install clean bench check-c check-flann check-py check-sanitizers check-abi \
+	check-valgrind check-determinism check-fuzz fuzz
 all: $(SHARED) $(STATIC) $(BUILD)/vpds.pc
 
 $(BUILD)/obj/%.o: libvpds/%.c $(LIB_HDR)
@@ -66,6 +73,32 @@ check-c: $(TEST_BIN)
 check-flann: $(FLANN_TEST)
 	$(FLANN_TEST)
 
+# libFuzzer harnesses (clang) and the same harnesses as plain programs that replay the corpus (gcc)
+$(BUILD)/fuzz/fuzz_%: fuzz/fuzz_%.c fuzz/fuzz_common.h $(LIB_SRC) $(LIB_HDR)
+	@mkdir -p $(dir $@)
+	clang $(FUZZ_FLAGS) $< $(LIB_SRC) -lm -o $@
+
+$(BUILD)/fuzz/replay_%: fuzz/fuzz_%.c fuzz/replay.c fuzz/fuzz_common.h $(STATIC)
+	@mkdir -p $(dir $@)
+	$(CC) -std=c99 -O2 -g -Iinclude -ffp-contract=off fuzz/replay.c $< -o $@ $(STATIC) -lm
+
+# make fuzz: each harness for FUZZ_SECONDS, growing build/fuzz/corpus_<name> from fuzz/corpus/<name>
+fuzz: $(FUZZERS:%=$(BUILD)/fuzz/fuzz_%)
+	@set -e; for f in $(FUZZERS); do mkdir -p $(BUILD)/fuzz/corpus_$$f; \
+	  echo "== fuzz_$$f for $(FUZZ_SECONDS) s"; \
+	  ASAN_OPTIONS=allocator_may_return_null=1 $(BUILD)/fuzz/fuzz_$$f -max_total_time=$(FUZZ_SECONDS) -max_len=512 -print_final_stats=1 \
+	    $(BUILD)/fuzz/corpus_$$f fuzz/corpus/$$f 2>&1 | grep -E "stat::number_of_executed_units|stat::average_exec_per_sec|ERROR|invariant" ; done
+
+check-fuzz: $(FUZZERS:%=$(BUILD)/fuzz/replay_%)
+	@set -e; for f in $(FUZZERS); do echo "== replay fuzz/corpus/$$f (gcc)"; $(BUILD)/fuzz/replay_$$f fuzz/corpus/$$f; done
+	$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(FUZZ_TEST_SECONDS)
+
+check-valgrind: $(TEST_BIN)
+	@set -e; for t in $(TEST_BIN); do echo "== valgrind $$t"; $(VALGRIND) $$t; done
+
+check-determinism:
+	bash tests/determinism.sh $(BUILD)/determinism
+
 check-abi: all
 	bash tests/abi_check.sh $(BUILD)
 
@@ -84,7 +117,8 @@ $(DEPS_STAMP): tools/deps.sh tests/requirements.txt
 	@mkdir -p $(BUILD) && touch $@
 
 test: $(DEPS_STAMP)
-	$(MAKE) --no-print-directory all check-c check-abi check-flann check-sanitizers check-py
+	$(MAKE) --no-print-directory all check-c check-abi check-flann check-sanitizers check-valgrind \
+	  check-determinism check-fuzz check-py
 	@echo "all tests passed"
 
 demo: $(BUILD)/demo/figure1

@@ -126,7 +126,7 @@ def main() -> None:
         row("libvpds 3D uniform (1e5)", vn, vs)
         row("crate fast_poisson 3D (1e5)", int(out[0]), float(out[1]),
             note=f"libvpds/peer samples-per-second: {(vn / vs) / (int(out[0]) / float(out[1])):.2f}")
-    n, sec, mem = vpds("uniform", 6, radius_for(1e4 if QUICK else 1e5, 6))
+    n, sec, mem = vpds("uniform", 6, radius_for(3e3 if QUICK else 1e4, 6))
     row("libvpds 6D uniform (maximal)", n, sec, mem)
 
 

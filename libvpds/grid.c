@@ -45,6 +45,9 @@ vpds_status vpds_grid_validate(const vpds_grid_desc *d, char *msg, size_t cap)
         if (!isfinite(lo) || !isfinite(hi) || !(lo < hi))
             FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: axis %u has lo = %g, hi = %g; need finite lo < hi",
                  (unsigned)k, lo, hi);
+        if (!isfinite(hi - lo) || !((hi - lo) / (double)(d->shape[k] - 1) > 0))
+            FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: axis %u: the node spacing (%g - %g) / %zu is "
+                 "not a positive finite number", (unsigned)k, hi, lo, d->shape[k] - 1);
     }
     for (i = 0; i < n; i++)
         if (!isfinite(d->values[i]) || !(d->values[i] > 0))
@@ -65,19 +68,19 @@ static double grid_exact_lipschitz(const vpds_grid *g)
         size_t base = 0;
         for (k = 0; k < d; k++) base += cell[k] * g->stride[k];
         for (c = 0; c < corners; c++) {
-            double s2 = 0;
+            double slope[VPDS_MAX_DIM], big = 0, s2 = 0, norm;
             for (k = 0; k < d; k++) {
-                size_t i0 = base, i1;
+                size_t i0 = base;
                 unsigned j;
                 for (j = 0; j < d; j++)
                     if (j != k && (c >> j & 1u)) i0 += g->stride[j];
-                i1 = i0 + g->stride[k];
-                {
-                    double slope = (g->values[i1] - g->values[i0]) / g->step[k];
-                    s2 += slope * slope;
-                }
+                slope[k] = fabs(g->values[i0 + g->stride[k]] - g->values[i0]) / g->step[k];
+                if (slope[k] > big) big = slope[k];
             }
-            if (s2 > best) best = s2;
+            /* scaled, so that squares overflow only when the norm itself does */
+            for (k = 0; k < d && big > 0 && isfinite(big); k++) s2 += (slope[k] / big) * (slope[k] / big);
+            norm = isfinite(big) ? big * sqrt(s2) : big;
+            if (norm > best) best = norm;
         }
         for (k = 0; k < d; k++) {
             if (++cell[k] < g->shape[k] - 1) break;
@@ -85,7 +88,7 @@ static double grid_exact_lipschitz(const vpds_grid *g)
         }
         if (k == d) break;
     }
-    return sqrt(best);
+    return best;
 }
 
 static void grid_refresh(vpds_grid *g)
@@ -222,12 +225,9 @@ double vpds_grid_eval(const vpds_grid *g, const double *x)
  * l1 distance transform, done exactly by a forward and a backward sweep along each axis. Its
  * interpolant then has corner gradients of norm <= sqrt(d * (L/sqrt(d))^2) = L. The price of
  * this sufficient condition: slopes along an axis are held to L/sqrt(d), not L. */
-vpds_status vpds_grid_enforce_lipschitz(vpds_grid *g, double L)
+static void envelope(vpds_grid *g, double L)
 {
-    size_t k, d;
-    if (!g || g->magic != VPDSI_GRID_COOKIE) return VPDS_ERR_INVALID_ARGUMENT;
-    if (!isfinite(L) || !(L > 0)) return VPDS_ERR_INVALID_ARGUMENT;
-    d = (size_t)g->dim;
+    size_t k, d = (size_t)g->dim;
     for (k = 0; k < d; k++) {
         double c = L * g->step[k] / sqrt((double)d);
         size_t len = g->shape[k], st = g->stride[k], line, lines = g->n / len;
@@ -244,6 +244,28 @@ vpds_status vpds_grid_enforce_lipschitz(vpds_grid *g, double L)
             }
         }
     }
-    grid_refresh(g);
+}
+
+vpds_status vpds_grid_enforce_lipschitz(vpds_grid *g, double L)
+{
+    double aim = L;
+    int round;
+    if (!g || g->magic != VPDSI_GRID_COOKIE) return VPDS_ERR_INVALID_ARGUMENT;
+    if (!isfinite(L) || !(L > 0)) return VPDS_ERR_INVALID_ARGUMENT;
+    /* v + c rounds: when slopes are tiny beside the values the result can exceed L by a few ulps
+     * of the values, so aim a little lower until the promise holds exactly */
+    for (round = 0; round < 8; round++) {
+        envelope(g, aim);
+        grid_refresh(g);
+        if (g->lipschitz <= L) return VPDS_OK;
+        aim -= 2 * (g->lipschitz - L) + L * 1e-15;
+        if (!(aim > 0)) break;
+    }
+    {
+        /* below what doubles can resolve at these values: the constant grid is the answer */
+        size_t i;
+        for (i = 0; i < g->n; i++) g->values[i] = g->vmin;
+        grid_refresh(g);
+    }
     return VPDS_OK;
 }

@@ -184,6 +184,29 @@ int main(void)
     }
     vpds_destroy(s);
 
+    /* refining while a run at another scale is paused */
+    d = vpds_default_desc(); d.radius = 0.02; d.budget = 100;
+    CHECK(vpds_create(&d, &s) == VPDS_OK && vpds_run(s) == VPDS_PAUSED);
+    CHECK(vpds_refine(s, 0.5) == VPDS_ERR_STATE && strstr(vpds_last_error(s), "is not finished"));
+    {
+        size_t before = vpds_count(s);
+        vpds_status st;
+        while ((st = vpds_run(s)) == VPDS_PAUSED) {}
+        CHECK(st == VPDS_OK && vpds_count(s) >= before);
+    }
+    vpds_destroy(s);
+
+    /* a grid whose node spacing underflows */
+    {
+        vpds_grid_desc gd = vpds_default_grid_desc();
+        size_t shape[1] = {3};
+        double v[3] = {1, 1, 1}, glo[1] = {0}, ghi[1] = {4e-324};
+        vpds_grid *g = NULL;
+        gd.dim = 1; gd.shape = shape; gd.values = v; gd.lo = glo; gd.hi = ghi;
+        CHECK(vpds_grid_validate(&gd, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT && strstr(msg, "node spacing"));
+        CHECK(vpds_grid_create(&gd, &g) == VPDS_ERR_INVALID_ARGUMENT && g == NULL);
+    }
+
     /* NULL sampler everywhere */
     CHECK(vpds_run(NULL) == VPDS_ERR_INVALID_ARGUMENT);
     CHECK(vpds_refine(NULL, 0.5) == VPDS_ERR_INVALID_ARGUMENT);

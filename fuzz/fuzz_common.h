@@ -1,0 +1,117 @@
+/* Shared by the fuzz harnesses: read typed values from the input bytes, and check the
+ * invariants every output must keep, so that a harness catches wrong answers, not only crashes. */
+#ifndef VPDS_FUZZ_COMMON_H
+#define VPDS_FUZZ_COMMON_H
+#include "vpds.h"
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct {
+    const uint8_t *p;
+    size_t n;
+} bytes_t;
+
+static uint8_t take_u8(bytes_t *b)
+{
+    uint8_t v = 0;
+    if (b->n) {
+        v = *b->p++;
+        b->n--;
+    }
+    return v;
+}
+
+static uint32_t take_u32(bytes_t *b)
+{
+    uint32_t v = 0;
+    int i;
+    for (i = 0; i < 4; i++) v = v << 8 | take_u8(b);
+    return v;
+}
+
+/* A double in [lo, hi], or now and then a special value (NaN, inf, 0, negative, huge). */
+static double take_double(bytes_t *b, double lo, double hi, int specials)
+{
+    uint8_t tag = take_u8(b);
+    if (specials && tag >= 248) {
+        static const double sp[8] = {0.0, -1.0, 1e300, -1e-300, 1e-300, 0.0, 0.0, 0.0};
+        if (tag == 248) return NAN;
+        if (tag == 249) return INFINITY;
+        if (tag == 250) return -INFINITY;
+        return sp[tag - 251];
+    }
+    return lo + (hi - lo) * (double)take_u32(b) / 4294967295.0;
+}
+
+#define FUZZ_ASSERT(cond, ...) do { if (!(cond)) { fprintf(stderr, "invariant broken: %s: ", #cond); \
+    fprintf(stderr, __VA_ARGS__); fputc('\n', stderr); abort(); } } while (0)
+
+static double rule_f(vpds_rule rule, double rx, double ry)
+{
+    switch (rule) {
+    case VPDS_RULE_PRIOR: return rx;
+    case VPDS_RULE_CURRENT: return ry;
+    case VPDS_RULE_BIGGER: return rx > ry ? rx : ry;
+    default: return rx < ry ? rx : ry;
+    }
+}
+
+/* Every status is one the API documents. */
+static void check_status(vpds_status st)
+{
+    FUZZ_ASSERT(st >= VPDS_ERR_OVERFLOW && st <= VPDS_STREAM_END, "status %d", (int)st);
+    FUZZ_ASSERT(strncmp(vpds_status_string(st), "VPDS_", 5) == 0, "status %d has no name", (int)st);
+}
+
+/* The samples so far: finite, r > 0, inside the box unless fixed, and no sample conflicts with
+ * one before it (Eq. 10, with the radii the library recorded and each sample's scale). */
+static void check_samples(const vpds_sampler *s, const double *lo, const double *hi,
+                          vpds_rule rule, double inhibition)
+{
+    size_t n = vpds_count(s), i, j;
+    int d = vpds_dim(s), k;
+    const double *x = vpds_points(s), *r = vpds_radii(s), *t = vpds_scales(s);
+    const uint8_t *fl = vpds_flags(s);
+    if (rule == VPDS_RULE_DEFAULT) rule = VPDS_RULE_SMALLER;
+    for (i = 0; i < n; i++) {
+        FUZZ_ASSERT(isfinite(r[i]) && r[i] > 0, "r[%zu] = %g", i, r[i]);
+        for (k = 0; k < d; k++) {
+            FUZZ_ASSERT(isfinite(x[i * d + k]), "x[%zu] not finite", i);
+            if (!(fl[i] & VPDS_FLAG_FIXED))
+                FUZZ_ASSERT(x[i * d + k] >= lo[k] && x[i * d + k] <= hi[k], "x[%zu] outside the box", i);
+        }
+        if (fl[i] & VPDS_FLAG_FIXED) {
+            FUZZ_ASSERT(isinf(t[i]), "fixed point %zu has t = %g", i, t[i]);
+            continue;
+        }
+        for (j = 0; j < i; j++) {
+            double d2 = 0, f = t[i] * inhibition * rule_f(rule, r[j], r[i]);
+            for (k = 0; k < d; k++) d2 += (x[i * d + k] - x[j * d + k]) * (x[i * d + k] - x[j * d + k]);
+            FUZZ_ASSERT(d2 >= f * f, "sample %zu conflicts with %zu (%g < %g)", i, j, sqrt(d2), f);
+        }
+    }
+}
+
+/* After a completed run: random probes in the box are covered (for a constant radius, where the
+ * harness knows r at any point). */
+static void check_covered(const vpds_sampler *s, const double *lo, const double *hi, double radius,
+                          double scale, bytes_t *b)
+{
+    size_t n = vpds_count(s), i, p;
+    int d = vpds_dim(s), k;
+    const double *x = vpds_points(s), *r = vpds_radii(s);
+    for (p = 0; p < 64; p++) {
+        double y[VPDS_MAX_DIM], best = INFINITY;
+        for (k = 0; k < d; k++) y[k] = lo[k] + (hi[k] - lo[k]) * (double)((take_u8(b) * 131 + p * 37) % 257) / 256.0;
+        for (i = 0; i < n; i++) {
+            double d2 = 0, f = scale * (r[i] < radius ? r[i] : radius);
+            for (k = 0; k < d; k++) d2 += (y[k] - x[i * d + k]) * (y[k] - x[i * d + k]);
+            if (sqrt(d2) - f < best) best = sqrt(d2) - f;
+        }
+        FUZZ_ASSERT(n > 0 && best <= 1e-9 * radius, "probe %zu uncovered by %g", p, best);
+    }
+}
+#endif

@@ -1,0 +1,67 @@
+/* Sequences of API calls decoded from the input: run, budgets, refine, next, fixed points,
+ * statistics, destroy; after each call the samples keep their invariants. */
+#include "fuzz_common.h"
+
+static double ramp_fn(const double *x, void *u) { (void)u; return 0.05 + 0.2 * fabs(x[0]); }
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    bytes_t b = {data, size};
+    vpds_desc d = vpds_default_desc();
+    double lo[VPDS_MAX_DIM] = {0}, hi[VPDS_MAX_DIM] = {1, 1, 1, 1, 1, 1, 1, 1};
+    vpds_sampler *s = NULL;
+    int ops = 0, k;
+    d.dim = 1 + take_u8(&b) % 3;
+    d.lo = lo;
+    d.hi = hi;
+    d.radius = d.dim == 1 ? 0.01 : d.dim == 2 ? 0.06 : 0.15;
+    d.rule = (vpds_rule)(take_u8(&b) % 5);
+    d.seed = take_u32(&b);
+    if (take_u8(&b) % 2) {
+        d.sizing = ramp_fn;
+        d.lipschitz = 0.2;
+    }
+    if (vpds_create(&d, &s) != VPDS_OK) abort();
+    while (b.n && ops++ < 24) {
+        vpds_status st = VPDS_OK;
+        uint8_t op = take_u8(&b) % 6;
+        if (op == 0) {
+            int calls;
+            for (calls = 0; calls < 1000 && (st = vpds_run(s)) == VPDS_PAUSED; calls++) {}
+            if (st == VPDS_OK) FUZZ_ASSERT(vpds_get_stats(s).maximal, "OK but not maximal");
+        } else if (op == 1) {
+            st = vpds_set_budget(s, take_u8(&b) % 3 ? take_u32(&b) % 3000 : 0);
+            FUZZ_ASSERT(st == VPDS_OK, "set_budget");
+        } else if (op == 2) {
+            double t = take_double(&b, 0.3, 1.5, 1);
+            st = vpds_refine(s, t);
+            while (st == VPDS_PAUSED) st = vpds_run(s);
+        } else if (op == 3) {
+            double x[VPDS_MAX_DIM], t;
+            st = vpds_next(s, 0, x, &t);
+        } else if (op == 4) {
+            size_t n = take_u8(&b) % 4, i;
+            double x[4 * VPDS_MAX_DIM], r[4];
+            int with_r = take_u8(&b) % 2;
+            for (i = 0; i < n; i++) {
+                for (k = 0; k < d.dim; k++) x[i * d.dim + k] = take_double(&b, -0.5, 1.5, 1);
+                r[i] = take_double(&b, 0.001, 0.3, 1);
+            }
+            {
+                size_t before = vpds_count(s);
+                st = vpds_add_points(s, n ? x : NULL, with_r ? r : NULL, n);
+                FUZZ_ASSERT(vpds_count(s) == (st == VPDS_OK ? before + n : before),
+                            "add_points changed the count on %d", (int)st);
+            }
+        } else {
+            vpds_stats stats = vpds_get_stats(s);
+            FUZZ_ASSERT(stats.accepted + 0 <= vpds_count(s) && stats.bytes_held <= stats.peak_bytes,
+                        "statistics");
+        }
+        check_status(st);
+        if (st < 0) FUZZ_ASSERT(vpds_last_error(s)[0] != 0, "error %d without a message", (int)st);
+        check_samples(s, lo, hi, d.rule, 1.0);
+    }
+    vpds_destroy(s);
+    return 0;
+}
