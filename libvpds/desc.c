@@ -49,6 +49,10 @@ vpds_status vpds_validate(const vpds_desc *d, char *msg, size_t cap)
                    k, lo, k, hi);
         if (!isfinite(hi - lo))
             REFUSE(VPDS_ERR_OVERFLOW, "desc.hi[%d] - desc.lo[%d] overflows", k, k);
+        if (fabs(lo) > VPDSI_MAGNITUDE_MAX || fabs(hi) > VPDSI_MAGNITUDE_MAX || hi - lo < VPDSI_MAGNITUDE_MIN)
+            REFUSE(VPDS_ERR_OVERFLOW, "desc axis %d: lo = %g, hi = %g; coordinates must stay within "
+                   "1e150 in magnitude and the extent at least 1e-150 (squared distances overflow "
+                   "or underflow beyond)", k, lo, hi);
         if (d->periodic && d->periodic[k])
             REFUSE(VPDS_ERR_UNSUPPORTED, "desc.periodic[%d] = %d: periodic axes are not supported by "
                    "this version", k, d->periodic[k]);
@@ -61,6 +65,9 @@ vpds_status vpds_validate(const vpds_desc *d, char *msg, size_t cap)
         REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.inhibition = %g: must be finite and > 0", d->inhibition);
     if (!isfinite(d->coverage) || !(d->coverage > 0))
         REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.coverage = %g: must be finite and > 0", d->coverage);
+    if (!vpdsi_scale_ok(d->coverage) || !vpdsi_scale_ok(d->inhibition))
+        REFUSE(VPDS_ERR_OVERFLOW, "desc.inhibition = %g, desc.coverage = %g: must be within [1e-50, "
+               "1e50]", d->inhibition, d->coverage);
     if (d->inhibition > d->coverage)
         REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.inhibition = %g > desc.coverage = %g: need R_f <= R_c",
                d->inhibition, d->coverage);
@@ -70,6 +77,10 @@ vpds_status vpds_validate(const vpds_desc *d, char *msg, size_t cap)
     if (d->domain)
         REFUSE(VPDS_ERR_UNSUPPORTED, "desc.domain: domains other than the box are not supported by "
                "this version");
+    if ((d->radius_min != 0 && !vpdsi_radius_ok(d->radius_min)) ||
+        (d->radius_max != 0 && !vpdsi_radius_ok(d->radius_max)))
+        REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.radius_min = %g, desc.radius_max = %g: must be 0 or "
+               "within [1e-100, 1e100]", d->radius_min, d->radius_max);
     if (!isfinite(d->radius_min) || d->radius_min < 0)
         REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.radius_min = %g: must be finite and >= 0", d->radius_min);
     if (!isfinite(d->radius_max) || d->radius_max < 0)
@@ -104,6 +115,9 @@ vpds_status vpds_validate(const vpds_desc *d, char *msg, size_t cap)
     } else {
         if (!isfinite(d->radius) || !(d->radius > 0))
             REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.radius = %g: must be finite and > 0", d->radius);
+        if (!vpdsi_radius_ok(d->radius))
+            REFUSE(VPDS_ERR_OVERFLOW, "desc.radius = %g: must be within [1e-100, 1e100] (squared "
+                   "distances overflow or underflow beyond)", d->radius);
     }
     limit = vpdsi_rule_max_lipschitz(d->rule);
     if (d->coverage * L >= limit)

@@ -50,9 +50,9 @@ vpds_status vpds_grid_validate(const vpds_grid_desc *d, char *msg, size_t cap)
                  "not a positive finite number", (unsigned)k, hi, lo, d->shape[k] - 1);
     }
     for (i = 0; i < n; i++)
-        if (!isfinite(d->values[i]) || !(d->values[i] > 0))
-            FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: values[%zu] = %g; radii must be finite and > 0",
-                 i, d->values[i]);
+        if (!(d->values[i] >= 1e-100 && d->values[i] <= 1e100))
+            FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: values[%zu] = %g; radii must be finite and > 0 "
+                 "(within [1e-100, 1e100])", i, d->values[i]);
     return VPDS_OK;
 }
 

@@ -237,6 +237,10 @@ vpds_status vpds_refine(vpds_sampler *s, double t)
         vpdsi_set_error(s, "t = %g: the scale must be finite and > 0", t);
         return VPDS_ERR_INVALID_ARGUMENT;
     }
+    if (!vpdsi_scale_ok(t * s->coverage)) {
+        vpdsi_set_error(s, "t = %g: t * coverage must be within [1e-50, 1e50]", t);
+        return VPDS_ERR_OVERFLOW;
+    }
     if (s->run.phase != VPDSI_IDLE && s->run.phase != VPDSI_DONE) {
         if (t == s->run.t) return run_checked(s); /* a paused refinement continues */
         vpdsi_set_error(s, "t = %g: the run at scale %g is not finished (call vpds_run until it "
@@ -281,13 +285,14 @@ vpds_status vpds_add_points(vpds_sampler *s, const double *x, const double *r, s
     }
     for (i = 0; i < n; i++) {
         for (k = 0; k < s->dim; k++)
-            if (!isfinite(x[i * (size_t)s->dim + (size_t)k])) {
-                vpdsi_set_error(s, "x[%zu][%d] = %g: fixed points must be finite", i, k,
-                                x[i * (size_t)s->dim + (size_t)k]);
+            if (!(fabs(x[i * (size_t)s->dim + (size_t)k]) <= VPDSI_MAGNITUDE_MAX)) {
+                vpdsi_set_error(s, "x[%zu][%d] = %g: fixed points must be finite (within 1e150)", i,
+                                k, x[i * (size_t)s->dim + (size_t)k]);
                 return VPDS_ERR_INVALID_ARGUMENT;
             }
-        if (r && (!isfinite(r[i]) || !(r[i] > 0))) {
-            vpdsi_set_error(s, "r[%zu] = %g: radii must be finite and > 0", i, r[i]);
+        if (r && !vpdsi_radius_ok(r[i])) {
+            vpdsi_set_error(s, "r[%zu] = %g: radii must be finite and > 0 (within [1e-100, 1e100])",
+                            i, r[i]);
             return VPDS_ERR_INVALID_ARGUMENT;
         }
     }

@@ -39,12 +39,12 @@ vpds_status vpdsi_sizing_eval(vpdsi_sizing *s, const double *x, size_t n, double
         for (i = 0; i < n; i++) out[i] = s->fn(x + i * (size_t)s->dim, s->user);
     }
     for (i = 0; i < n; i++) {
-        if (!isfinite(out[i]) || !(out[i] > 0)) {
+        if (!vpdsi_radius_ok(out[i])) {
             if (err && cap) {
                 char pt[256];
                 vpdsi_format_point(pt, sizeof pt, x + i * (size_t)s->dim, s->dim);
-                snprintf(err, cap, "sizing returned r = %g at x = (%s); r must be finite and > 0",
-                         out[i], pt);
+                snprintf(err, cap, "sizing returned r = %g at x = (%s); r must be finite and > 0%s",
+                         out[i], pt, out[i] > 0 && isfinite(out[i]) ? " (within [1e-100, 1e100])" : "");
             }
             return VPDS_ERR_SIZING;
         }

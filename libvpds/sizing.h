@@ -4,6 +4,19 @@
 #define VPDS_SIZING_H
 #include "grid.h"
 
+/* Distances are compared squared; beyond these ranges the squares overflow or underflow and a
+ * conflict could be missed: coordinates within 1e150, extents at least 1e-150, radii within
+ * [1e-100, 1e100] and scale factors (t * coverage) within [1e-50, 1e50], so that every reach
+ * lies in [1e-150, 1e150]. */
+#define VPDSI_MAGNITUDE_MIN 1e-150
+#define VPDSI_MAGNITUDE_MAX 1e150
+#define VPDSI_RADIUS_MIN 1e-100
+#define VPDSI_RADIUS_MAX 1e100
+#define VPDSI_SCALE_MIN 1e-50
+#define VPDSI_SCALE_MAX 1e50
+static inline int vpdsi_radius_ok(double r) { return r >= VPDSI_RADIUS_MIN && r <= VPDSI_RADIUS_MAX; }
+static inline int vpdsi_scale_ok(double t) { return t >= VPDSI_SCALE_MIN && t <= VPDSI_SCALE_MAX; }
+
 typedef enum { VPDSI_SIZING_CONSTANT, VPDSI_SIZING_GRID, VPDSI_SIZING_CALLBACK } vpdsi_sizing_kind;
 
 typedef struct vpdsi_sizing {

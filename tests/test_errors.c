@@ -107,8 +107,23 @@ int main(void)
     d = vpds_default_desc(); d.lipschitz = 0.49; d.rule = VPDS_RULE_PRIOR; d.sizing = ramp;
     CHECK(vpds_validate(&d, msg, sizeof msg) == VPDS_OK);
 
+    /* magnitudes whose squares would overflow or underflow */
+    d = vpds_default_desc(); d.radius = 1e-300; refused(&d, "desc.radius = 1e-300: must be within [1e-100, 1e100]", VPDS_ERR_OVERFLOW);
+    d.radius = 1e200; refused(&d, "desc.radius = 1e+200", VPDS_ERR_OVERFLOW);
+    {
+        double l3[2] = {0, 0}, h3[2] = {1e200, 1};
+        d = vpds_default_desc(); d.lo = l3; d.hi = h3;
+        refused(&d, "coordinates must stay within 1e150", VPDS_ERR_OVERFLOW);
+        h3[0] = 1e-200;
+        refused(&d, "the extent at least 1e-150", VPDS_ERR_OVERFLOW);
+    }
+    d = vpds_default_desc(); d.coverage = d.inhibition = 1e60; refused(&d, "must be within [1e-50, 1e50]", VPDS_ERR_OVERFLOW);
+
     /* a request whose base grid overflows: refused at run, sampler unchanged and usable */
-    d = vpds_default_desc(); d.radius = 1e-300;
+    {
+        static double l4[2] = {0, 0}, h4[2] = {1e100, 1};
+        d = vpds_default_desc(); d.radius = 1e-90; d.lo = l4; d.hi = h4;
+    }
     CHECK(vpds_create(&d, &s) == VPDS_OK);
     CHECK(vpds_run(s) == VPDS_ERR_OVERFLOW && strstr(vpds_last_error(s), "overflows"));
     CHECK(vpds_count(s) == 0);
@@ -163,7 +178,8 @@ int main(void)
     d = vpds_default_desc();
     CHECK(vpds_create(&d, &s) == VPDS_OK);
     {
-        double x[4] = {0.5, 0.5, NAN, 0.2}, r[2] = {0.1, -1};
+        double x[4] = {0.5, 0.5, NAN, 0.2}, r[2] = {0.1, -1}, huge[2] = {1e200, 0};
+        CHECK(vpds_add_points(s, huge, NULL, 1) == VPDS_ERR_INVALID_ARGUMENT && strstr(vpds_last_error(s), "within 1e150"));
         CHECK(vpds_add_points(s, NULL, NULL, 1) == VPDS_ERR_INVALID_ARGUMENT && strstr(vpds_last_error(s), "x is NULL"));
         CHECK(vpds_add_points(s, x, NULL, 2) == VPDS_ERR_INVALID_ARGUMENT && strstr(vpds_last_error(s), "x[1][0] = nan"));
         CHECK(vpds_add_points(s, x, r, 1) == VPDS_OK);
@@ -175,6 +191,7 @@ int main(void)
     /* refinement and the stream */
     CHECK(vpds_refine(s, NAN) == VPDS_ERR_INVALID_ARGUMENT && strstr(vpds_last_error(s), "t = nan"));
     CHECK(vpds_refine(s, -1) == VPDS_ERR_INVALID_ARGUMENT);
+    CHECK(vpds_refine(s, 1e-60) == VPDS_ERR_OVERFLOW && strstr(vpds_last_error(s), "[1e-50, 1e50]"));
     CHECK(vpds_run(s) == VPDS_OK);
     CHECK(vpds_refine(s, 1.0) == VPDS_OK); /* already maximal at 1 */
     CHECK(vpds_refine(s, 1.5) == VPDS_ERR_STATE && strstr(vpds_last_error(s), "t = 1.5"));
