@@ -102,7 +102,9 @@ check-determinism:
 check-abi: all
 	bash tests/abi_check.sh $(BUILD)
 
+# the Python binding builds the C library into its extension: one pip install, nothing else
 check-py: $(SAMPLE_TOOL)
+	python3 -m pip install -q --disable-pip-version-check ./bindings/python
 	python3 -m pytest -q tests/py
 
 # The C tests again with AddressSanitizer and UndefinedBehaviorSanitizer (a separate build).

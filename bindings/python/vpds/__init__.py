@@ -1,0 +1,13 @@
+"""vpds: maximal Poisson-disk sampling with spatially varying radii, in any dimension.
+
+    >>> import vpds
+    >>> engine = vpds.PoissonDisk(2, radius=0.05, rng=1)
+    >>> x = engine.fill_space()          # maximal, shape (n, 2)
+"""
+from ._core import (RULES, PoissonDisk, SizingGrid, VpdsError, VpdsSizingError, VpdsStateError,
+                    VpdsUnsupportedError, VpdsValueError)
+from ._vpds import ffi as _ffi, lib as _lib
+
+__version__ = _ffi.string(_lib.vpds_version_string()).decode()
+__all__ = ["PoissonDisk", "SizingGrid", "VpdsError", "VpdsValueError", "VpdsSizingError",
+           "VpdsUnsupportedError", "VpdsStateError", "RULES", "__version__"]

@@ -1,0 +1,191 @@
+"""The Python binding: a drop-in for scipy.stats.qmc.PoissonDisk, numpy results, errors as
+exceptions with the C message, callbacks, Ctrl-C, determinism, copies that outlive the engine."""
+import gc
+
+import numpy as np
+import pytest
+from scipy.spatial.distance import pdist
+from scipy.stats import qmc
+
+import checker as C
+
+vpds = pytest.importorskip("vpds")
+
+RAMP = lambda p: 0.001 + 0.3 * p[:, 0]  # noqa: E731 - the paper's Figure 1
+
+
+@pytest.mark.parametrize("engine_cls", [qmc.PoissonDisk, vpds.PoissonDisk])
+def test_drop_in_for_scipy(engine_cls):
+    """The same calls run against scipy and vpds give arrays of the same kind and guarantees."""
+    kw = dict(radius=0.1, rng=7, l_bounds=[-1, 2], u_bounds=[1, 3], hypersphere="volume",
+              ncandidates=30, optimization=None)
+    if engine_cls is vpds.PoissonDisk:
+        kw["progress"] = False
+    engine = engine_cls(2, **kw)
+    first = engine.random(5)
+    assert first.shape == (5, 2) and first.dtype == np.float64
+    rest = engine.fill_space()
+    allp = np.vstack([first, rest])
+    assert allp.ndim == 2 and allp.shape[1] == 2 and len(allp) > 50
+    assert np.all(allp >= [-1, 2]) and np.all(allp <= [1, 3])
+    assert pdist(allp).min() >= 0.1 * (1 - 1e-9)
+    engine.reset()
+    again = engine.random(5)
+    assert again.shape == (5, 2)
+    with pytest.raises(ValueError):
+        engine_cls(2, radius=0.1, hypersphere="cube")
+
+
+def test_vpds_fill_space_is_maximal_and_scipys_is_not_required_to_be():
+    engine = vpds.PoissonDisk(2, radius=0.05, rng=3, progress=False)
+    x = engine.fill_space()
+    sizing = C.sizing_named("const", 0.05)
+    rep = C.check_maximal(x, np.full(len(x), 0.05), "smaller", 1.0, sizing, np.zeros(2), np.ones(2))
+    assert rep.gaps == 0 and engine.stats["maximal"]
+
+
+def test_random_is_a_prefix_of_one_process_and_stops_when_maximal():
+    a = vpds.PoissonDisk(2, radius=0.05, rng=11, progress=False)
+    b = vpds.PoissonDisk(2, radius=0.05, rng=11, progress=False)
+    x = np.vstack([a.random(7), a.random(30)])
+    y = b.random(37)
+    np.testing.assert_array_equal(x, y)
+    full = b.fill_space()
+    c = vpds.PoissonDisk(2, radius=0.05, rng=11, progress=False)
+    everything = c.random(10**6)  # fewer: the set is maximal first
+    assert len(everything) == 37 + len(full)
+    np.testing.assert_array_equal(everything, np.vstack([y, full]))
+    assert len(c.random(5)) == 0
+
+
+def test_rng_int_is_the_c_seed_and_generators_are_reproducible():
+    a = vpds.PoissonDisk(3, radius=0.2, rng=123, progress=False)
+    assert a.seed == 123
+    x1 = vpds.PoissonDisk(3, radius=0.2, rng=np.random.default_rng(5), progress=False).fill_space()
+    x2 = vpds.PoissonDisk(3, radius=0.2, rng=np.random.default_rng(5), progress=False).fill_space()
+    np.testing.assert_array_equal(x1, x2)
+    x3 = vpds.PoissonDisk(3, radius=0.2, rng=np.random.default_rng(6), progress=False).fill_space()
+    assert len(x1) != len(x3) or not np.array_equal(x1, x3)
+    with pytest.raises(ValueError, match="2\\*\\*64"):
+        vpds.PoissonDisk(2, rng=-1)
+
+
+@pytest.mark.parametrize("rule", ["prior", "current", "bigger", "smaller"])
+def test_callable_sizing_all_rules(rule):
+    engine = vpds.PoissonDisk(2, sizing=RAMP, lipschitz=0.3, rule=rule, rng=1, progress=False)
+    x = engine.fill_space()
+    np.testing.assert_allclose(engine.radii, RAMP(x), rtol=0)
+    assert C.empty_disk_violations(x, engine.radii, rule, 1.0, 0.3) == 0
+    rep = C.check_maximal(x, engine.radii, rule, 1.0, C.sizing_named("ramp"), np.zeros(2), np.ones(2))
+    assert rep.gaps == 0
+
+
+def test_grid_sizing_computes_and_enforces_lipschitz():
+    g = np.array([[0.02, 0.02], [0.2, 0.05]])  # axis 0 along x[0]
+    engine = vpds.PoissonDisk(2, sizing=g, rng=2, progress=False)
+    expected = np.hypot(0.18, 0.15)  # corner (1, 0): edges 0.2 - 0.02 and 0.05 - 0.2
+    assert engine.lipschitz == pytest.approx(expected, rel=1e-12)
+    x = engine.fill_space()
+    grid = vpds.SizingGrid(g, [0, 0], [1, 1])
+    np.testing.assert_allclose(engine.radii, grid(x), rtol=1e-12)
+    steep = np.array([[0.01, 0.01], [0.9, 0.9]])
+    with pytest.raises(vpds.VpdsValueError, match="Table 1"):
+        vpds.PoissonDisk(2, sizing=steep, rule="prior")
+    ok = vpds.PoissonDisk(2, sizing=steep, rule="prior", enforce_lipschitz=0.4, progress=False)
+    assert ok.lipschitz <= 0.4 and len(ok.fill_space()) > 0
+
+
+def test_errors_carry_the_c_message():
+    with pytest.raises(vpds.VpdsValueError, match="desc.radius = -1"):
+        vpds.PoissonDisk(2, radius=-1)
+    with pytest.raises(vpds.VpdsValueError, match="desc.lipschitz is required"):
+        vpds.PoissonDisk(2, sizing=RAMP)
+    with pytest.raises(vpds.VpdsValueError, match="limit 0.5"):
+        vpds.PoissonDisk(2, sizing=RAMP, lipschitz=0.5, rule="prior")
+    with pytest.raises(NotImplementedError, match="two radii"):
+        vpds.PoissonDisk(2, inhibition=0.5, coverage=1.0)
+    with pytest.raises(ValueError, match="rule"):
+        vpds.PoissonDisk(2, rule="largest")
+    with pytest.raises(vpds.VpdsValueError, match="desc.dim = 9"):
+        vpds.PoissonDisk(9)
+    engine = vpds.PoissonDisk(2, sizing=lambda p: np.where(p[:, 0] > 0.5, np.nan, 0.05),
+                              lipschitz=0.1, rng=1, progress=False)
+    with pytest.raises(vpds.VpdsSizingError, match="r = nan at x = \\("):
+        engine.fill_space()
+    assert np.all(engine.points[:, 0] <= 0.5)  # nothing accepted where r is NaN
+
+
+def test_callback_exceptions_propagate_with_their_cause():
+    def bad(p):
+        raise ZeroDivisionError("user bug")
+    engine = vpds.PoissonDisk(2, sizing=bad, lipschitz=0.1, radius_max=0.1, progress=False)
+    with pytest.raises(vpds.VpdsSizingError) as info:
+        engine.fill_space()
+    assert isinstance(info.value.__cause__, ZeroDivisionError)
+    wrong_shape = vpds.PoissonDisk(2, sizing=lambda p: np.ones(3) * 0.1, lipschitz=0.1,
+                                   radius_max=0.1, progress=False)
+    with pytest.raises(vpds.VpdsSizingError) as info:
+        wrong_shape.fill_space()
+    assert "shape" in str(info.value.__cause__)
+
+
+def test_ctrl_c_leaves_a_valid_state_that_continues_to_the_same_points():
+    calls = {"n": 0, "interrupt_at": 40}
+
+    def sizing(p):
+        calls["n"] += 1
+        if calls["n"] == calls["interrupt_at"]:
+            raise KeyboardInterrupt
+        return RAMP(p)
+    ref = vpds.PoissonDisk(2, sizing=RAMP, lipschitz=0.3, rng=9, progress=False).fill_space()
+    engine = vpds.PoissonDisk(2, sizing=sizing, lipschitz=0.3, rng=9, progress=False)
+    with pytest.raises(KeyboardInterrupt):
+        engine.fill_space()
+    partial = engine.points
+    assert 0 < len(partial) < len(ref)
+    np.testing.assert_array_equal(partial, ref[: len(partial)])
+    rest = engine.fill_space()
+    np.testing.assert_array_equal(np.vstack([engine.points]), ref)
+    assert len(rest) == len(ref)
+
+
+def test_results_are_copies_that_outlive_the_engine():
+    engine = vpds.PoissonDisk(2, radius=0.1, rng=4, progress=False)
+    x = engine.fill_space()
+    keep = x.copy()
+    r, t = engine.radii, engine.scales
+    del engine
+    gc.collect()
+    np.testing.assert_array_equal(x, keep)
+    assert np.all(r == 0.1) and np.all(t == 1.0)
+
+
+def test_fixed_points_come_first_and_are_respected():
+    fx = np.array([[0.5, 0.5], [0.1, 0.9]])
+    engine = vpds.PoissonDisk(2, radius=0.05, fixed_points=fx, fixed_radii=[0.3, 0.02], rng=1,
+                              progress=False)
+    x = engine.fill_space()
+    pts = engine.points
+    np.testing.assert_array_equal(pts[:2], fx)
+    assert engine.fixed[:2].all() and not engine.fixed[2:].any()
+    assert np.all(np.isinf(engine.scales[:2]))
+    d0 = np.linalg.norm(x - fx[0], axis=1)
+    assert d0.min() >= 0.05  # smaller rule: min(0.3, 0.05)
+    engine.reset()
+    assert len(engine.points) == 2
+
+
+def test_refine_to_a_smaller_scale():
+    engine = vpds.PoissonDisk(2, radius=0.05, rng=5, progress=False)
+    coarse = engine.fill_space()
+    new = engine.refine(0.5)
+    allp = engine.points
+    np.testing.assert_array_equal(allp[: len(coarse)], coarse)
+    assert len(new) > len(coarse)
+    np.testing.assert_array_equal(engine.scales[len(coarse):], 0.5)
+    assert pdist(allp).min() >= 0.025 * (1 - 1e-12)
+    rep = C.check_maximal(allp, np.full(len(allp), 0.05), "smaller", 0.5,
+                          C.sizing_named("const", 0.05), np.zeros(2), np.ones(2))
+    assert rep.gaps == 0
+    with pytest.raises(vpds.VpdsStateError, match="below the current scale"):
+        engine.refine(0.8)
