@@ -124,8 +124,7 @@ test: $(DEPS_STAMP)
 	@echo "all tests passed"
 
 demo: $(BUILD)/demo/figure1
-	@mkdir -p out
-	$(BUILD)/demo/figure1 out
+	bash tools/demo.sh $(BUILD)
 
 $(BUILD)/bench/bench: bench/bench.c $(STATIC)
 	@mkdir -p $(dir $@)

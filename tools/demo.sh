@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# make demo: the paper's Figure 1 with each rule (C example: CSVs; the vpds command: PNGs), and
+# Figure 10's radial sizing on a quarter of its square (PNG and .npz), from a fresh clone.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BUILD=${1:-build}
+mkdir -p out
+start=$(date +%s)
+python3 -m pip install -q --disable-pip-version-check numpy cffi matplotlib tqdm
+python3 -m pip install -q --disable-pip-version-check ./bindings/python
+echo "== the C example: $BUILD/demo/figure1 (r = 0.001 + 0.3x, each rule)"
+"$BUILD/demo/figure1" out
+echo "== the vpds command"
+for rule in prior current bigger smaller; do
+  python3 -m vpds sample --sizing "0.001 + 0.3*x[0]" --lipschitz 0.3 --rule "$rule" --seed 2024 \
+    --plot "out/figure1_$rule.png" --no-progress
+done
+python3 -m vpds sample --lo 0.5 --hi 1 --rule bigger --seed 1 --lipschitz 0.3733 --no-progress \
+  --sizing "0.015 + (0.00015 - 0.015)*abs(sin(8*pi*sqrt((x[0]-0.5)**2 + (x[1]-0.5)**2)))" \
+  -o out/figure10_quarter.npz --plot out/figure10_quarter.png
+echo "demo: wrote out/figure1_<rule>.csv and .png, out/figure10_quarter.npz and .png in $(( $(date +%s) - start )) s"
