@@ -6,6 +6,14 @@
 #include <string.h>
 
 static double ramp(const double *x, void *u) { (void)u; return 0.001 + 0.3 * x[0]; }
+static int ramp_batch(const double *x, size_t n, double *r, void *u)
+{
+    size_t i, *calls = (size_t *)u;
+    for (i = 0; i < n; i++) r[i] = 0.001 + 0.3 * x[2 * i];
+    calls[0]++;
+    calls[1] += n;
+    return 0;
+}
 
 typedef struct {
     size_t live_bytes, calls, fail_at; /* fail_at: the allocation that fails (0: none) */
@@ -81,6 +89,19 @@ int main(void)
     other = run_copy(&d, &n);
     CHECK(other && (n != n_ref || memcmp(ref, other, n * 2 * sizeof(double)) != 0));
     free(other);
+
+    /* the batched sizing callback: the same points as the per-point one, in far fewer calls */
+    {
+        size_t calls[2] = {0, 0};
+        d = ramp_desc(42);
+        d.sizing = NULL;
+        d.sizing_batch = ramp_batch;
+        d.sizing_user = calls;
+        other = run_copy(&d, &n);
+        CHECK(other && n == n_ref && memcmp(ref, other, n * 2 * sizeof(double)) == 0);
+        CHECK_MSG(calls[1] > 100 * calls[0], "%zu points in %zu calls", calls[1], calls[0]);
+        free(other);
+    }
 
     /* budgets of several sizes: paused many times, same points */
     {
