@@ -1,7 +1,12 @@
 /* The C API: determinism by seed, budgets and pauses resume to the same points, fixed points,
  * the custom allocator (every allocation failure recovers to the same points, nothing leaks). */
+#define _GNU_SOURCE /* backtrace(), to count the allocation sites the failure test reaches */
 #include "check.h"
 #include "vpds.h"
+#include "mem.h"
+#ifdef __GLIBC__
+#include <execinfo.h>
+#endif
 #include <math.h>
 #include <string.h>
 
@@ -18,12 +23,51 @@ static int ramp_batch(const double *x, size_t n, double *r, void *u)
 typedef struct {
     size_t live_bytes, calls, fail_at; /* fail_at: the allocation that fails (0: none) */
     int failed;
+    void *sites[64]; /* distinct library call sites that asked for memory */
+    size_t n_sites;
 } counting_alloc;
+
+/* The library call site that asked the memory layer (mem.c) for memory: the first frame of
+ * the stack that is not in this allocator or in mem.c's two functions. */
+static int in_function(void *addr, void (*fn)(void))
+{
+    const char *a = (const char *)addr, *f = (const char *)(size_t)fn;
+    return a >= f && a < f + 768; /* both mem.c functions are shorter than this */
+}
+
+static void *ca_alloc(size_t size, void *user);
+
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static void note_site(counting_alloc *a)
+{
+#ifdef __GLIBC__
+    void *frames[12];
+    int n = backtrace(frames, 12), k;
+    size_t i;
+    for (k = 1; k < n; k++) {
+        if (in_function(frames[k], (void (*)(void))(size_t)vpdsi_mem_alloc) ||
+            in_function(frames[k], (void (*)(void))(size_t)vpdsi_mem_reserve) ||
+            in_function(frames[k], (void (*)(void))(size_t)note_site) ||
+            in_function(frames[k], (void (*)(void))(size_t)ca_alloc))
+            continue;
+        break;
+    }
+    if (k >= n) return;
+    for (i = 0; i < a->n_sites; i++)
+        if (a->sites[i] == frames[k]) return;
+    if (a->n_sites < 64) a->sites[a->n_sites++] = frames[k];
+#else
+    (void)a;
+#endif
+}
 
 static void *ca_alloc(size_t size, void *user)
 {
     counting_alloc *a = (counting_alloc *)user;
     a->calls++;
+    note_site(a);
     if (a->fail_at && a->calls == a->fail_at) {
         a->failed = 1;
         return NULL;
@@ -227,7 +271,7 @@ int main(void)
         for (which = 0; which < 2; which++) {
             counting_alloc ca;
             vpds_sampler *s = NULL;
-            size_t total, k, reached = 0, n_base;
+            size_t total, k, reached = 0, n_base, sites;
             double *base;
             memset(&ca, 0, sizeof ca);
             d = ramp_desc(42);
@@ -245,6 +289,7 @@ int main(void)
             vpds_destroy(s);
             CHECK(ca.live_bytes == 0);
             total = ca.calls;
+            sites = ca.n_sites;
             CHECK(total > 10);
             for (k = 1; k <= total; k++) {
                 vpds_status st;
@@ -272,9 +317,9 @@ int main(void)
             /* the grid's own allocations (stencil, cells, candidates) may fail without an error:
              * the run falls back to the kd-tree, with the same points as checked above */
             CHECK(reached <= total && total - reached <= (which ? 5u : 0u));
-            printf("allocation failure (%s): %zu allocations of a run each failed once, %zu seen"
-                   " as VPDS_ERR_OUT_OF_MEMORY\n", which ? "uniform, grid" : "ramp, kd-tree",
-                   total, reached);
+            printf("allocation failure (%s): %zu allocations from %zu call sites, each failed once,"
+                   " %zu seen as VPDS_ERR_OUT_OF_MEMORY\n", which ? "uniform, grid" : "ramp, kd-tree",
+                   total, sites, reached);
             free(base);
         }
     }
