@@ -14,7 +14,7 @@ TOOL = Path(os.environ.get("VPDS_SAMPLE_TOOL", ROOT / "build" / "tests" / "sampl
 @pytest.fixture(scope="session")
 def sample(tmp_path_factory):
     """sample(dim, rule, sizing, radius, seed, lo, hi) -> (x, r, t) from the C library."""
-    import checker
+    from vpds import analysis as checker
 
     out_dir = tmp_path_factory.mktemp("samples")
 

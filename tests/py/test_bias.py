@@ -13,7 +13,7 @@ import pytest
 from scipy import stats
 from scipy.spatial import cKDTree
 
-import checker as C
+from vpds import analysis as C
 
 PIXELS = 384
 RUNS = 320

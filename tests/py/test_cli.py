@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-import checker as C
+from vpds import analysis as C
 
 pytest.importorskip("vpds")
 
@@ -68,3 +68,41 @@ def test_errors_exit_non_zero_with_the_c_message(tmp_path):
     assert res.returncode == 2 and "not supported" in res.stderr
     res = vpds("sample", "-o", str(tmp_path / "x.txt"), check=False)
     assert res.returncode != 0 and ".npy, .npz, .csv or .ply" in res.stderr
+
+
+def test_analyze_passes_a_sampling_and_fails_a_corrupted_one(tmp_path):
+    pytest.importorskip("matplotlib")
+    good = tmp_path / "good.npz"
+    vpds("sample", "--sizing", "0.01 + 0.02*x[0]", "--lipschitz", "0.02", "--rule", "current",
+         "--seed", "2", "-o", str(good), "--no-progress")
+    res = vpds("analyze", str(good), "--rule", "current", "--sizing", "0.01 + 0.02*x[0]",
+               "--lipschitz", "0.02", "--plot", str(tmp_path / "a.png"), check=False)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "all guarantees hold" in res.stdout and "min angle" in res.stdout
+    assert (tmp_path / "a.png").read_bytes()[:4] == b"\x89PNG"
+    z = dict(np.load(good))
+    gap = tmp_path / "gap.npz"
+    np.savez(gap, points=np.delete(z["points"], 10, axis=0), radii=np.delete(z["radii"], 10),
+             scales=np.delete(z["scales"], 10), fixed=np.delete(z["fixed"], 10))
+    res = vpds("analyze", str(gap), "--rule", "current", "--sizing", "0.01 + 0.02*x[0]",
+               "--lipschitz", "0.02", check=False)
+    assert res.returncode == 1 and "maximality" in res.stdout and "FAIL" in res.stdout
+    close = tmp_path / "close.npz"
+    p = np.vstack([z["points"], z["points"][:1] + 0.001])
+    np.savez(close, points=p, radii=0.01 + 0.02 * p[:, 0], scales=np.ones(len(p)),
+             fixed=np.zeros(len(p), bool))
+    res = vpds("analyze", str(close), "--rule", "current", "--sizing", "0.01 + 0.02*x[0]",
+               "--lipschitz", "0.02", check=False)
+    assert res.returncode == 1 and "empty disk" in res.stdout.split("FAILED")[-1]
+
+
+def test_spectrum_shows_blue_noise():
+    """A maximal sampling has little power at low frequencies, uniform random points do not."""
+    import vpds as v
+    x = v.PoissonDisk(2, radius=0.02, rng=1, progress=False).fill_space()
+    sp = C.spectrum(x, np.zeros(2), np.ones(2))
+    ring = np.sqrt(len(x))
+    low = sp.radial_mean[sp.radii < 0.4 * ring].mean()
+    white = C.spectrum(np.random.default_rng(0).random((len(x), 2)), np.zeros(2), np.ones(2))
+    assert low < 0.3 and 0.7 < white.radial_mean.mean() < 1.3
+    assert np.all(sp.power >= 0) and sp.power[len(sp.frequencies) // 2, len(sp.frequencies) // 2] == 0

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-import checker as C
+from vpds import analysis as C
 
 UNIFORM = [(1, 0.002, 1.0), (2, 0.02, 1.0), (3, 0.08, 1.0), (4, 0.2, 1.0), (5, 0.3, 1.0),
            (6, 0.45, 0.8)]

@@ -7,7 +7,7 @@ import pytest
 from scipy.spatial.distance import pdist
 from scipy.stats import qmc
 
-import checker as C
+from vpds import analysis as C
 
 vpds = pytest.importorskip("vpds")
 

@@ -9,6 +9,7 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
+from . import analysis
 from ._core import RULES, PoissonDisk, VpdsError
 
 # names a --sizing expression may use, besides x (the coordinates, x[k] the k-th, shape (d, m))
@@ -135,6 +136,124 @@ def cmd_sample(args: argparse.Namespace) -> int:
     return 0
 
 
+def read_points(path: Path):
+    """(points, radii or None, scales or None) from .npz, .npy, .csv or .ply as `sample` writes."""
+    suffix = path.suffix.lower()
+    if suffix == ".npz":
+        z = np.load(path)
+        return z["points"], z["radii"], z["scales"]
+    if suffix == ".npy":
+        return np.load(path), None, None
+    if suffix == ".csv":
+        header = path.read_text().splitlines()[0].split(",")
+        table = np.atleast_2d(np.loadtxt(path, delimiter=",", skiprows=1))
+        dims = [i for i, h in enumerate(header) if h in ("x", "y", "z") or (h[:1] == "x" and h[1:].isdigit())]
+        col = {h: i for i, h in enumerate(header)}
+        return table[:, dims], table[:, col["r"]] if "r" in col else None, table[:, col["t"]] if "t" in col else None
+    if suffix == ".ply":
+        lines = path.read_text().splitlines()
+        body = np.atleast_2d(np.loadtxt(lines[lines.index("end_header") + 1:]))
+        keep = [k for k in range(3) if np.any(body[:, k] != 0)] or [0]
+        return body[:, : max(keep) + 1], body[:, 3], body[:, 4]
+    raise SystemExit(f"vpds analyze: {path}: use .npz, .npy, .csv or .ply")
+
+
+def cmd_analyze(args: argparse.Namespace) -> int:
+    x, r, t = read_points(Path(args.file))
+    n, dim = x.shape
+    lo = _floats(args.lo, dim, 0.0, "--lo")
+    hi = _floats(args.hi, dim, 1.0, "--hi")
+    scale = args.scale if args.scale is not None else (
+        float(t[np.isfinite(t)].min()) if t is not None and np.isfinite(t).any() else 1.0)
+    if args.sizing:
+        fn = sizing_from_expression(args.sizing, dim)
+        if args.lipschitz is None:
+            raise SystemExit("vpds analyze: --sizing needs --lipschitz")
+        sizing = analysis.Sizing(fn, args.lipschitz)
+    elif args.radius is not None or (r is not None and np.all(r == r[0])):
+        sizing = analysis.sizing_named("const", args.radius if args.radius is not None else float(r[0]))
+    else:
+        sizing = None
+    if r is None:
+        if sizing is None:
+            raise SystemExit("vpds analyze: the file has no radii: give --radius or --sizing")
+        r = sizing.fn(x)
+    lipschitz = sizing.lipschitz if sizing is not None else 0.0
+    failed = []
+    print(f"{n} points in {dim}D, rule {args.rule}, scale t = {scale:g}")
+    bad = analysis.empty_disk_violations(x, r, args.rule, scale, lipschitz)
+    print(f"empty disk (Eq. 10, insertion order): {bad} conflicting pairs -> {'OK' if bad == 0 else 'FAIL'}")
+    if bad:
+        failed.append("empty disk")
+    if sizing is None:
+        print("maximality: not checked (radii vary: give --sizing and --lipschitz)")
+    else:
+        rep = analysis.check_maximal(x, r, args.rule, scale, sizing, lo, hi)
+        ok = rep.gaps == 0 and rep.probes_max_rel <= 1e-9
+        print(f"maximality (branch-and-bound, {rep.boxes} boxes; probes): {rep.gaps} uncovered "
+              f"points found -> {'OK' if ok else 'FAIL'}")
+        if not ok:
+            failed.append("maximality")
+    report = None
+    if dim == 2 and n >= 3:
+        report = analysis.check_delaunay(x, r, args.rule, scale * lipschitz, lo, hi)
+        emin, emax = report.edge_min_bound * scale, report.edge_max_bound * scale
+        ok = (report.min_angle_deg >= report.angle_bound_deg and report.edge_min_ratio >= emin * (1 - 1e-12)
+              and report.edge_max_ratio <= emax * (1 + 1e-12)) if sizing is not None else True
+        print(f"Delaunay ({report.triangles} interior triangles): min angle {report.min_angle_deg:.2f} deg "
+              f"(Table 1: >= {report.angle_bound_deg:.2f}), edge / r(x) in [{report.edge_min_ratio:.3f}, "
+              f"{report.edge_max_ratio:.3f}] (Table 1: [{emin:.3f}, {emax:.3f}]) -> {'OK' if ok else 'FAIL'}")
+        if not ok:
+            failed.append("Table 1 bounds")
+    if args.plot:
+        plot_analysis(Path(args.plot), x, r, lo, hi, report, args.rule, scale * lipschitz, scale)
+        print(f"wrote {args.plot}")
+    print("all guarantees hold" if not failed else "FAILED: " + ", ".join(failed))
+    return 1 if failed else 0
+
+
+def plot_analysis(path: Path, x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                  report, rule: str, lipschitz: float, scale: float) -> None:
+    """One PNG: the points, the periodogram (DC removed), radial mean power, anisotropy, and in
+    2D the Delaunay minimum-angle and edge-ratio histograms with the Table 1 bounds."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(2, 3, figsize=(15, 9.5))
+    ax = axes[0, 0]
+    ax.plot(x[:, 0], x[:, 1] if x.shape[1] > 1 else np.zeros(len(x)), ",", color="black")
+    ax.set_aspect("equal")
+    ax.set_title(f"{len(x)} points")
+    if x.shape[1] >= 2:
+        sp = analysis.spectrum(x, lo, hi)
+        k = sp.frequencies
+        axes[0, 1].imshow(np.log10(sp.power.T + 1e-3), origin="lower", cmap="gray",
+                          extent=[k[0], k[-1], k[0], k[-1]], vmin=-1.5, vmax=1)
+        axes[0, 1].set_title("periodogram, DC removed (log10)")
+        axes[0, 2].plot(sp.radii, sp.radial_mean, lw=1)
+        axes[0, 2].axhline(1, color="gray", lw=0.5)
+        axes[0, 2].set_title("radial mean power")
+        axes[0, 2].set_xlabel("|f|")
+        axes[1, 0].plot(sp.radii, sp.anisotropy_db, lw=1)
+        axes[1, 0].set_ylim(-20, 10)
+        axes[1, 0].set_title("anisotropy (dB)")
+        axes[1, 0].set_xlabel("|f|")
+    if report is not None and x.shape[1] == 2:
+        angles, ratios = analysis.delaunay_histograms(x, r, lo, hi)
+        e_min, e_max, sin_min = analysis.table1_bounds(rule, lipschitz)
+        axes[1, 1].hist(angles, bins=60, color="tab:blue")
+        axes[1, 1].axvline(np.degrees(np.arcsin(sin_min)), color="red", label="Table 1 bound")
+        axes[1, 1].set_title("Delaunay minimum angle (degrees)")
+        axes[1, 1].legend()
+        axes[1, 2].hist(ratios, bins=80, color="tab:blue")
+        for b in (e_min * scale, e_max * scale):
+            axes[1, 2].axvline(b, color="red")
+        axes[1, 2].set_title("Delaunay edge length / r(x), Table 1 bounds")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="vpds", description="Maximal Poisson-disk sampling with "
                                      "spatially varying radii (libvpds).")
@@ -159,6 +278,19 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--plot", help="write a PNG of the samples (with their disks for small n)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
     s.set_defaults(func=cmd_sample)
+    a = sub.add_parser("analyze", help="check a sampling's guarantees and plot its spectrum")
+    a.add_argument("file", help=".npz, .npy, .csv or .ply (as `vpds sample -o` writes)")
+    a.add_argument("--rule", choices=sorted(RULES), default="smaller")
+    a.add_argument("--radius", type=float, help="constant radius (when the file has none)")
+    a.add_argument("--sizing", help="r(x) as a numpy expression in x (needed for maximality "
+                   "when radii vary)")
+    a.add_argument("--lipschitz", type=float)
+    a.add_argument("--lo")
+    a.add_argument("--hi")
+    a.add_argument("--scale", type=float, help="the scale t to check at (default: the file's "
+                   "smallest finite t, else 1)")
+    a.add_argument("--plot", help="write the analysis PNG")
+    a.set_defaults(func=cmd_analyze)
     return parser
 
 

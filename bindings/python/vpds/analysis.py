@@ -1,7 +1,7 @@
-"""Independent checks of a sampling against the paper's definitions.
+"""Checks of a sampling against the paper's definitions, and its spectral analysis.
 
-Written from the paper alone, with numpy and scipy's cKDTree: nothing here calls or copies the
-library's code. A sampling is checked for
+Written from the paper alone, with numpy and scipy: nothing here calls or copies the C library,
+so it is an independent check of its output (the project's tests use it, and `vpds analyze`). A sampling is checked for
   - the empty-disk property in insertion order (Eq. 10 with the rule's f),
   - maximality (Eq. 11 empty): a branch-and-bound over the box on the coverage margin
         g(y) = min_i |y - x_i| - s f(x_i, y),
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, Optional
 
 import numpy as np
 from scipy.spatial import Delaunay, cKDTree
@@ -210,13 +210,12 @@ def table1_bounds(rule: str, L: float) -> tuple[float, float, float]:
     return 1 / (1 + L), 2 / (1 - L), (1 - L) / 2
 
 
-def check_delaunay(x: np.ndarray, r: np.ndarray, rule: str, L: float, lo: np.ndarray,
-                   hi: np.ndarray, sizing: Sizing | None = None) -> DelaunayReport:
-    """Table 1 on triangles whose circumcentre lies in the box (where maximality holds)."""
+def _interior_triangles(x: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+    """Delaunay triangles whose circumcentre lies in the box (where maximality bounds them):
+    vertex indices, edge lengths opposite each vertex, circumcentres, circumradii, angles."""
     tri = Delaunay(x)
     s = tri.simplices
     a, b, c = x[s[:, 0]], x[s[:, 1]], x[s[:, 2]]
-    # circumcentres
     d = 2 * (a[:, 0] * (b[:, 1] - c[:, 1]) + b[:, 0] * (c[:, 1] - a[:, 1]) + c[:, 0] * (a[:, 1] - b[:, 1]))
     ux = ((a ** 2).sum(1) * (b[:, 1] - c[:, 1]) + (b ** 2).sum(1) * (c[:, 1] - a[:, 1]) + (c ** 2).sum(1) * (a[:, 1] - b[:, 1])) / d
     uy = ((a ** 2).sum(1) * (c[:, 0] - b[:, 0]) + (b ** 2).sum(1) * (a[:, 0] - c[:, 0]) + (c ** 2).sum(1) * (b[:, 0] - a[:, 0])) / d
@@ -229,17 +228,70 @@ def check_delaunay(x: np.ndarray, r: np.ndarray, rule: str, L: float, lo: np.nda
     ang_a = np.arccos(np.clip((lb ** 2 + lc ** 2 - la ** 2) / (2 * lb * lc), -1, 1))
     ang_b = np.arccos(np.clip((la ** 2 + lc ** 2 - lb ** 2) / (2 * la * lc), -1, 1))
     ang_c = np.pi - ang_a - ang_b
-    min_angle = float(np.degrees(np.minimum(np.minimum(ang_a, ang_b), ang_c).min()))
+    return s, (la, lb, lc), u, np.linalg.norm(a - u, axis=1), (ang_a, ang_b, ang_c)
+
+
+def _edge_ratios(s: np.ndarray, lengths, r: np.ndarray) -> np.ndarray:
+    la, lb, lc = lengths
+    return np.concatenate([la / r[s[:, 1]], la / r[s[:, 2]], lb / r[s[:, 2]], lb / r[s[:, 0]],
+                           lc / r[s[:, 0]], lc / r[s[:, 1]]])
+
+
+def check_delaunay(x: np.ndarray, r: np.ndarray, rule: str, L: float, lo: np.ndarray,
+                   hi: np.ndarray, sizing: Sizing | None = None) -> DelaunayReport:
+    """Table 1 on triangles whose circumcentre lies in the box (where maximality holds)."""
+    s, lengths, u, R, angles = _interior_triangles(x, lo, hi)
+    min_angle = float(np.degrees(np.minimum(np.minimum(*angles[:2]), angles[2]).min()))
     e_min, e_max, sin_min = table1_bounds(rule, L)
-    ratios = []
-    for (p, q, length) in ((1, 2, la), (2, 0, lb), (0, 1, lc)):
-        ratios.append(length / r[s[:, p]])
-        ratios.append(length / r[s[:, q]])
-    ratios = np.concatenate(ratios)
-    R = np.linalg.norm(a - u, axis=1)
+    ratios = _edge_ratios(s, lengths, r)
     circ = 0.0
     if sizing is not None:
         circ = float((R / sizing.fn(u)).max())
     circ_bound = 1 / (1 - L) if rule in ("prior", "bigger") else 1.0
     return DelaunayReport(int(len(s)), min_angle, math.degrees(math.asin(sin_min)),
                           float(ratios.min()), e_min, float(ratios.max()), e_max, circ, circ_bound)
+
+
+@dataclass
+class Spectrum:
+    """Point Set Analysis (Schlomer 2011) of a 2D set normalised to the unit square."""
+
+    frequencies: np.ndarray   # integer frequencies -K..K along each axis
+    power: np.ndarray         # periodogram |sum exp(-2 pi i f.x)|^2 / n, DC removed
+    radii: np.ndarray         # annulus centres |f|
+    radial_mean: np.ndarray   # mean power per annulus
+    anisotropy_db: np.ndarray  # 10 log10(variance / mean^2) per annulus
+
+
+def spectrum(x: np.ndarray, lo: np.ndarray, hi: np.ndarray, k_max: Optional[int] = None,
+             max_points: int = 10_000, seed: int = 0) -> Spectrum:
+    """Periodogram with the DC removed, radial mean power and anisotropy (the paper's
+    Figures 6-8). Large sets are subsampled to max_points (uniformly, without replacement).
+    Frequencies reach twice sqrt(n), beyond the first ring of a maximal set (near sqrt(n))."""
+    u = (x[:, :2] - lo[:2]) / (hi[:2] - lo[:2])
+    if len(u) > max_points:
+        u = u[np.random.default_rng(seed).choice(len(u), max_points, replace=False)]
+    if k_max is None:
+        k_max = int(min(200, max(32, 2 * np.sqrt(len(u)))))
+    f = np.arange(-k_max, k_max + 1)
+    ex = np.exp(-2j * np.pi * np.outer(u[:, 0], f))
+    ey = np.exp(-2j * np.pi * np.outer(u[:, 1], f))
+    power = np.abs(ex.T @ ey) ** 2 / len(u)
+    power[k_max, k_max] = 0.0
+    fx, fy = np.meshgrid(f, f, indexing="ij")
+    rad = np.hypot(fx, fy)
+    bins = np.arange(1, k_max + 1)
+    which = np.floor(rad).astype(int)
+    mean = np.array([power[which == b].mean() for b in bins])
+    var = np.array([power[which == b].var() for b in bins])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        aniso = 10 * np.log10(var / mean ** 2)
+    return Spectrum(f, power, bins + 0.5, mean, aniso)
+
+
+def delaunay_histograms(x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+    """Minimum angle (degrees) of each triangle whose circumcentre is in the box, and the edge
+    length / r(x) ratios of their edges (both endpoints)."""
+    s, lengths, _, _, angles = _interior_triangles(x, lo, hi)
+    min_angles = np.degrees(np.minimum(np.minimum(*angles[:2]), angles[2]))
+    return min_angles, _edge_ratios(s, lengths, r)
