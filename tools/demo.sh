@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 BUILD=${1:-build}
 mkdir -p out
 start=$(date +%s)
-python3 -m pip install -q --disable-pip-version-check numpy cffi matplotlib tqdm
+python3 -m pip install -q --disable-pip-version-check numpy cffi matplotlib tqdm OpenEXR
 python3 -m pip install -q --disable-pip-version-check ./bindings/python
 echo "== the C example: $BUILD/demo/figure1 (r = 0.001 + 0.3x, each rule)"
 "$BUILD/demo/figure1" out
@@ -18,4 +18,18 @@ done
 python3 -m vpds sample --lo 0.5 --hi 1 --rule bigger --seed 1 --lipschitz 0.3733 --no-progress \
   --sizing "0.015 + (0.00015 - 0.015)*abs(sin(8*pi*sqrt((x[0]-0.5)**2 + (x[1]-0.5)**2)))" \
   -o out/figure10_quarter.npz --plot out/figure10_quarter.png
-echo "demo: wrote out/figure1_<rule>.csv and .png, out/figure10_quarter.npz and .png in $(( $(date +%s) - start )) s"
+echo "== an image-driven sizing: out/sizing.exr (written here with the OpenEXR package)"
+python3 - <<'PY'
+import numpy as np, OpenEXR
+h, w = 128, 128
+y, x = np.mgrid[0:h, 0:w] / 127.0
+# dark (small radii) on a ring and in two dots, bright elsewhere
+img = np.clip(np.abs(np.hypot(x - 0.5, y - 0.5) - 0.32) / 0.2, 0, 1)
+for cx in (0.38, 0.62):
+    img = np.minimum(img, np.clip(np.hypot(x - cx, y - 0.4) / 0.12, 0, 1))
+OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage},
+             {"Y": OpenEXR.Channel(img.astype(np.float32))}).write("out/sizing.exr")
+PY
+python3 -m vpds sample --sizing-exr out/sizing.exr --exr-range 0.003,0.03 --lipschitz 0.3 \
+  --seed 1 -o out/image.npz --plot out/image.png --no-progress
+echo "demo: wrote out/figure1_<rule>.csv and .png, out/figure10_quarter.npz and .png, out/image.npz and .png in $(( $(date +%s) - start )) s"

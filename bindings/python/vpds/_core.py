@@ -1,8 +1,8 @@
 """The Python face of libvpds: a drop-in for scipy.stats.qmc.PoissonDisk, and more."""
 from __future__ import annotations
 
-import math
 import numbers
+import os
 from typing import Any, Callable, Iterator, Optional, Sequence, Union
 
 import numpy as np
@@ -145,8 +145,10 @@ class PoissonDisk:
 
     Beyond scipy:
       sizing:     None (use `radius`), a float, a numpy grid of radii over the bounds (d axes,
-                  C order, multilinear), a `SizingGrid`, or a vectorised callable r(x) taking
-                  points of shape (m, d) and returning (m,) radii (called in batches from C).
+                  C order, multilinear), a `SizingGrid`, a vectorised callable r(x) taking
+                  points of shape (m, d) and returning (m,) radii (called in batches from C),
+                  or the path of an OpenEXR image (2D; `sizing_channel`, `sizing_range`: see
+                  vpds.exr for the mapping of pixels to radii).
       lipschitz:  L of r; required with a callable, computed for a grid (a larger value may be
                   given). With `enforce_lipschitz=L` a grid is first lowered to be L-Lipschitz.
       rule:       "prior", "current", "bigger" or "smaller" (Table 1 of the paper).
@@ -166,7 +168,8 @@ class PoissonDisk:
                  radius_min: Optional[float] = None, radius_max: Optional[float] = None,
                  fixed_points: Optional[npt.ArrayLike] = None,
                  fixed_radii: Optional[npt.ArrayLike] = None, progress: bool = True,
-                 seed: Optional[int] = None):
+                 seed: Optional[int] = None, sizing_channel: Optional[str] = None,
+                 sizing_range: Optional[Sequence[float]] = None):
         if hypersphere not in ("volume", "surface"):
             raise ValueError(f"{hypersphere!r} is not a valid hypersphere sampling method. It "
                              "must be one of {'volume', 'surface'} (it has no effect here)")
@@ -204,6 +207,10 @@ class PoissonDisk:
             desc.periodic = per
             self._keep.append(per)
         desc.radius = self.radius
+        if isinstance(sizing, (str, os.PathLike)):
+            from .exr import sizing_grid_from_exr
+            sizing = sizing_grid_from_exr(sizing, self.l_bounds, self.u_bounds, sizing_channel,
+                                          sizing_range)
         if sizing is not None and not callable(sizing) and np.ndim(sizing) == 0:
             desc.radius = float(sizing)
             self.radius = float(sizing)

@@ -103,9 +103,18 @@ def cmd_sample(args: argparse.Namespace) -> int:
     dim = args.dim
     lo = _floats(args.lo, dim, 0.0, "--lo")
     hi = _floats(args.hi, dim, 1.0, "--hi")
-    if args.sizing_exr:
-        raise SystemExit("vpds sample: --sizing-exr is not supported by this version")
     sizing = sizing_from_expression(args.sizing, dim) if args.sizing else None
+    grid_lipschitz = None
+    if args.sizing_exr:
+        from .exr import sizing_grid_from_exr
+        exr_range = [float(v) for v in args.exr_range.split(",")] if args.exr_range else None
+        try:
+            sizing = sizing_grid_from_exr(args.sizing_exr, lo, hi, args.channel, exr_range)
+        except (ValueError, ImportError, OSError) as exc:
+            raise SystemExit(f"vpds sample: --sizing-exr {args.sizing_exr}: {exc}") from None
+        if args.lipschitz is not None:
+            sizing.enforce_lipschitz(args.lipschitz)  # "smoothed for L" (lowers values only)
+            grid_lipschitz, args.lipschitz = args.lipschitz, None
     periodic = None
     if args.periodic:
         axes = {int(a) for a in args.periodic.split(",")} if args.periodic != "all" else set(range(dim))
@@ -124,7 +133,10 @@ def cmd_sample(args: argparse.Namespace) -> int:
             engine.refine(t)
     seconds = time.perf_counter() - t0
     x, r, t, fixed = engine.points, engine.radii, engine.scales, engine.fixed
-    what = f"r = {args.sizing}" if args.sizing else f"radius {engine.radius}"
+    what = (f"r = {args.sizing}" if args.sizing else f"r from {args.sizing_exr}" if args.sizing_exr
+            else f"radius {engine.radius}")
+    if grid_lipschitz is not None:
+        what += f", smoothed for L = {grid_lipschitz}"
     print(f"{len(x)} samples in {dim}D ({what}, rule {args.rule}, seed {engine.seed}) in "
           f"{seconds:.3f} s; maximal: {bool(engine.stats['maximal'])}")
     if args.output:
@@ -265,7 +277,11 @@ def build_parser() -> argparse.ArgumentParser:
     size = s.add_mutually_exclusive_group()
     size.add_argument("--radius", type=float, default=0.05, help="constant radius (default 0.05)")
     size.add_argument("--sizing", help="r(x) as a numpy expression in x, e.g. '0.001 + 0.3*x[0]'")
-    size.add_argument("--sizing-exr", help="(not supported by this version)")
+    size.add_argument("--sizing-exr", help="r from an OpenEXR image over the box (2D); with "
+                      "--lipschitz L the image is first smoothed for L (values only lowered)")
+    s.add_argument("--channel", help="EXR channel (default Y, R or L, or the only one)")
+    s.add_argument("--exr-range", help="r_min,r_max: pixel values in [0, 1] map linearly onto "
+                   "this range (default: pixel values are radii)")
     s.add_argument("--lipschitz", type=float, help="L of r (required with --sizing)")
     s.add_argument("--rule", choices=sorted(RULES), default="smaller")
     s.add_argument("--inhibition", type=float, default=1.0)
