@@ -189,3 +189,18 @@ def test_refine_to_a_smaller_scale():
     assert rep.gaps == 0
     with pytest.raises(vpds.VpdsStateError, match="below the current scale"):
         engine.refine(0.8)
+
+
+def test_callable_sampled_onto_a_grid_is_an_approximation_with_its_own_l():
+    f = lambda p: 0.02 + 0.01 * np.sin(6 * p[:, 0]) * np.cos(4 * p[:, 1])  # noqa: E731
+    engine = vpds.PoissonDisk(2, sizing=f, sizing_grid_shape=(33, 17), rng=1, progress=False)
+    g = vpds.SizingGrid(f(np.stack(np.meshgrid(np.linspace(0, 1, 33), np.linspace(0, 1, 17),
+                                               indexing="ij"), -1).reshape(-1, 2)).reshape(33, 17),
+                        [0, 0], [1, 1])
+    assert engine.lipschitz == pytest.approx(g.lipschitz, rel=1e-15)
+    assert engine.lipschitz <= np.hypot(0.06, 0.04) + 1e-12  # the callable's own L bounds it
+    x = engine.fill_space()
+    np.testing.assert_allclose(engine.radii, g(x), rtol=1e-12)
+    assert np.abs(engine.radii - f(x)).max() < 1e-3  # close to the callable, not equal
+    with pytest.raises(ValueError, match="samples a callable"):
+        vpds.PoissonDisk(2, sizing=0.1, sizing_grid_shape=(3, 3))

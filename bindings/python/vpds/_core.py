@@ -149,6 +149,9 @@ class PoissonDisk:
                   points of shape (m, d) and returning (m,) radii (called in batches from C),
                   or the path of an OpenEXR image (2D; `sizing_channel`, `sizing_range`: see
                   vpds.exr for the mapping of pixels to radii).
+      sizing_grid_shape: sample a callable onto a grid of that many nodes per axis and use the
+                  multilinear grid instead: an approximation of the callable (exact at the
+                  nodes), with its own, computed L; no Python calls during the run.
       lipschitz:  L of r; required with a callable, computed for a grid (a larger value may be
                   given). With `enforce_lipschitz=L` a grid is first lowered to be L-Lipschitz.
       rule:       "prior", "current", "bigger" or "smaller" (Table 1 of the paper).
@@ -169,7 +172,8 @@ class PoissonDisk:
                  fixed_points: Optional[npt.ArrayLike] = None,
                  fixed_radii: Optional[npt.ArrayLike] = None, progress: bool = True,
                  seed: Optional[int] = None, sizing_channel: Optional[str] = None,
-                 sizing_range: Optional[Sequence[float]] = None):
+                 sizing_range: Optional[Sequence[float]] = None,
+                 sizing_grid_shape: Optional[Sequence[int]] = None):
         if hypersphere not in ("volume", "surface"):
             raise ValueError(f"{hypersphere!r} is not a valid hypersphere sampling method. It "
                              "must be one of {'volume', 'surface'} (it has no effect here)")
@@ -211,6 +215,18 @@ class PoissonDisk:
             from .exr import sizing_grid_from_exr
             sizing = sizing_grid_from_exr(sizing, self.l_bounds, self.u_bounds, sizing_channel,
                                           sizing_range)
+        if sizing_grid_shape is not None:
+            if not callable(sizing):
+                raise ValueError("sizing_grid_shape samples a callable sizing onto a grid; "
+                                 f"sizing is {type(sizing).__name__}")
+            axes = [np.linspace(a, b, int(m)) for a, b, m in
+                    zip(self.l_bounds, self.u_bounds, sizing_grid_shape)]
+            if len(axes) != self.d:
+                raise ValueError(f"sizing_grid_shape has {len(axes)} values for d = {self.d}")
+            nodes = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, self.d)
+            values = np.asarray(sizing(nodes), dtype=np.float64).reshape(tuple(int(m) for m in sizing_grid_shape))
+            sizing = SizingGrid(values, self.l_bounds, self.u_bounds)
+            lipschitz = None  # the grid's own, exact L replaces the callable's
         if sizing is not None and not callable(sizing) and np.ndim(sizing) == 0:
             desc.radius = float(sizing)
             self.radius = float(sizing)
