@@ -42,7 +42,7 @@ __attribute__((noinline))
 #endif
 static void note_site(counting_alloc *a)
 {
-#ifdef __GLIBC__
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) /* instrumented code breaks the 768-byte window */
     void *frames[12];
     int n = backtrace(frames, 12), k;
     size_t i;
@@ -317,9 +317,9 @@ int main(void)
             /* the grid's own allocations (stencil, cells, candidates) may fail without an error:
              * the run falls back to the kd-tree, with the same points as checked above */
             CHECK(reached <= total && total - reached <= (which ? 5u : 0u));
-            printf("allocation failure (%s): %zu allocations from %zu call sites, each failed once,"
-                   " %zu seen as VPDS_ERR_OUT_OF_MEMORY\n", which ? "uniform, grid" : "ramp, kd-tree",
-                   total, sites, reached);
+            printf("allocation failure (%s): %zu allocations from %zu call sites (0: not counted in"
+                   " this build), each failed once, %zu seen as VPDS_ERR_OUT_OF_MEMORY\n",
+                   which ? "uniform, grid" : "ramp, kd-tree", total, sites, reached);
             free(base);
         }
     }
