@@ -296,9 +296,10 @@ vpds_status vpds_add_points(vpds_sampler *s, const double *x, const double *r, s
             return VPDS_ERR_INVALID_ARGUMENT;
         }
     }
+    /* fixed points may share cells and carry other radii: the kd-tree takes over, and it must
+     * first hold every sample (it lags after a run on the background grid) */
+    if ((st = vpdsi_sync_tree(s)) != VPDS_OK) return st;
     if (s->grid_mode) {
-        /* fixed points may share cells and carry other radii: the kd-tree takes over */
-        if ((st = vpdsi_sync_tree(s)) != VPDS_OK) return st;
         s->grid_mode = 0;
         vpdsi_bgrid_release(&s->grid, &s->mem);
     }

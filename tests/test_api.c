@@ -264,6 +264,29 @@ int main(void)
         }
     }
 
+    /* fixed points added after a run on the background grid, then a refinement on the kd-tree:
+     * the kd-tree must hold the grid's samples too (a regression: they were missing) */
+    {
+        vpds_sampler *s;
+        double far[2] = {50, 50}, tiny = 1e-6;
+        size_t i, j, n, bad = 0;
+        d = vpds_default_desc();
+        d.radius = 0.05;
+        d.seed = 3;
+        CHECK(vpds_create(&d, &s) == VPDS_OK && vpds_run(s) == VPDS_OK);
+        CHECK(vpds_add_points(s, far, &tiny, 1) == VPDS_OK);
+        CHECK(vpds_refine(s, 0.5) == VPDS_OK);
+        n = vpds_count(s);
+        for (i = 0; i < n; i++)
+            for (j = 0; j < i; j++) {
+                const double *a = vpds_points(s) + 2 * i, *b = vpds_points(s) + 2 * j;
+                double t = vpds_scales(s)[i], f = t * (vpds_radii(s)[j] < 0.05 ? vpds_radii(s)[j] : 0.05);
+                if (!isinf(t) && hypot(a[0] - b[0], a[1] - b[1]) < f) bad++;
+            }
+        CHECK_MSG(bad == 0, "%zu conflicting pairs after add_points and refine", bad);
+        vpds_destroy(s);
+    }
+
     /* allocator: count the allocations of a run, then fail each one in turn (a variable-radius
      * run on the kd-tree, and a uniform one on the background grid) */
     {
