@@ -29,11 +29,13 @@ typedef struct {
 
 /* The library call site that asked the memory layer (mem.c) for memory: the first frame of
  * the stack that is not in this allocator or in mem.c's two functions. */
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)
 static int in_function(void *addr, void (*fn)(void))
 {
     const char *a = (const char *)addr, *f = (const char *)(size_t)fn;
     return a >= f && a < f + 768; /* both mem.c functions are shorter than this */
 }
+#endif
 
 static void *ca_alloc(size_t size, void *user);
 
