@@ -85,9 +85,10 @@ static vpds_status setup(vpds_sampler *s)
         }
         run->n0[k] = cells < 1 ? 1 : (uint64_t)cells;
         run->side0[k] = ext / (double)run->n0[k];
-        if (total > (UINT64_C(1) << 62) / run->n0[k]) {
-            vpdsi_set_error(s, "scale t = %g: the base grid has more than 2^62 cells (radius too"
-                            " small for the box)", run->t);
+        if (total > (UINT64_C(1) << 40) / run->n0[k]) {
+            /* no machine holds a sampling that fine: refuse rather than exhaust memory */
+            vpdsi_set_error(s, "scale t = %g: the base grid has more than 2^40 cells (radius too"
+                            " small for the box); the cell count overflows", run->t);
             return VPDS_ERR_OVERFLOW;
         }
         total *= run->n0[k];

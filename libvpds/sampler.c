@@ -259,8 +259,21 @@ vpds_status vpds_refine(vpds_sampler *s, double t)
                         t, t * s->coverage * s->sizing.lipschitz, vpdsi_rule_name(s->rule), limit);
         return VPDS_ERR_INVALID_ARGUMENT;
     }
-    vpdsi_mps_reset(s, t);
-    return run_checked(s);
+    {
+        /* a refinement that fails before any work (out of memory, overflow) must leave the
+         * sampler at its old scale, as if it had not been called */
+        double old_t = s->run.t;
+        vpdsi_phase old_phase = s->run.phase;
+        vpds_status st;
+        vpdsi_mps_reset(s, t);
+        st = run_checked(s);
+        if (st < 0 && s->run.phase == VPDSI_IDLE) {
+            s->run.t = old_t;
+            s->run.phase = old_phase;
+            s->stats.t = old_t;
+        }
+        return st;
+    }
 }
 
 vpds_status vpds_next(vpds_sampler *s, double t_min, double *x_out, double *t_out)
@@ -321,19 +334,22 @@ vpds_status vpds_add_points(vpds_sampler *s, const double *x, const double *r, s
         if (a == 1) break;
         step += 2;
     }
-    for (i = 0, pos = 0; i < n; i++, pos = (pos + step) % n) {
-        double ri = r ? r[pos] : s->buf_r[pos];
-        size_t at = s->n;
-        memcpy(s->x + at * (size_t)s->dim, x + pos * (size_t)s->dim, (size_t)s->dim * sizeof(double));
-        s->r[at] = ri;
-        s->t[at] = INFINITY;
-        s->flags[at] = (uint8_t)(VPDSI_SAMPLE_FIXED | (r ? VPDSI_SAMPLE_OWN_RADIUS : 0u));
-        s->n++;
-        {
-            vpdsi_kd_samples v = vpdsi_samples_view(s);
-            vpdsi_kd_insert(&s->tree, &v, (int32_t)at);
-            s->tree_n = s->n;
+    /* stored in the caller's order; inserted into the kd-tree in a scattered order */
+    {
+        size_t first = s->n;
+        vpdsi_kd_samples v;
+        for (i = 0; i < n; i++) {
+            memcpy(s->x + (first + i) * (size_t)s->dim, x + i * (size_t)s->dim,
+                   (size_t)s->dim * sizeof(double));
+            s->r[first + i] = r ? r[i] : s->buf_r[i];
+            s->t[first + i] = INFINITY;
+            s->flags[first + i] = (uint8_t)(VPDSI_SAMPLE_FIXED | (r ? VPDSI_SAMPLE_OWN_RADIUS : 0u));
         }
+        s->n += n;
+        v = vpdsi_samples_view(s);
+        for (i = 0, pos = 0; i < n; i++, pos = (pos + step) % n)
+            vpdsi_kd_insert(&s->tree, &v, (int32_t)(first + pos));
+        s->tree_n = s->n;
     }
     s->n_fixed += n;
     return VPDS_OK;

@@ -266,6 +266,46 @@ int main(void)
         }
     }
 
+    /* fixed points keep the caller's order (many of them: the kd-tree gets them scattered) */
+    {
+        vpds_sampler *s;
+        double fx[2 * 40], fr[40];
+        for (i = 0; i < 40; i++) {
+            fx[2 * i] = 0.1 + 0.02 * (double)i;
+            fx[2 * i + 1] = 0.5;
+            fr[i] = 0.001 * (double)(i + 1);
+        }
+        d = vpds_default_desc();
+        d.radius = 0.05;
+        CHECK(vpds_create(&d, &s) == VPDS_OK && vpds_add_points(s, fx, fr, 40) == VPDS_OK);
+        CHECK(memcmp(vpds_points(s), fx, sizeof fx) == 0 && memcmp(vpds_radii(s), fr, sizeof fr) == 0);
+        CHECK(vpds_run(s) == VPDS_OK && memcmp(vpds_points(s), fx, sizeof fx) == 0);
+        vpds_destroy(s);
+    }
+
+    /* a refinement that fails before any work leaves the sampler at its old scale */
+    {
+        counting_alloc ca;
+        vpds_sampler *s;
+        size_t before;
+        memset(&ca, 0, sizeof ca);
+        d = vpds_default_desc();
+        d.radius = 0.05;
+        d.allocator.alloc = ca_alloc;
+        d.allocator.free = ca_free;
+        d.allocator.user = &ca;
+        CHECK(vpds_create(&d, &s) == VPDS_OK && vpds_run(s) == VPDS_OK);
+        before = vpds_count(s);
+        CHECK(vpds_refine(s, 1e-7) == VPDS_ERR_OVERFLOW); /* a cell count that overflows */
+        CHECK(vpds_get_stats(s).t == 1.0 && vpds_get_stats(s).maximal && vpds_count(s) == before);
+        ca.fail_at = ca.calls + 1; /* the next allocation fails: the grid for t = 0.5 */
+        CHECK(vpds_refine(s, 0.5) == VPDS_OK || vpds_get_stats(s).t == 1.0);
+        ca.fail_at = 0;
+        CHECK(vpds_refine(s, 0.5) == VPDS_OK && vpds_get_stats(s).t == 0.5 && vpds_count(s) > before);
+        vpds_destroy(s);
+        CHECK(ca.live_bytes == 0);
+    }
+
     /* fixed points added after a run on the background grid, then a refinement on the kd-tree:
      * the kd-tree must hold the grid's samples too (a regression: they were missing) */
     {
