@@ -21,12 +21,6 @@ void vpdsi_kd_release(vpdsi_kdtree *t, vpdsi_mem *m)
     vpdsi_kd_init(t, t->dim);
 }
 
-size_t vpdsi_kd_bytes(const vpdsi_kdtree *t)
-{
-    return t->cap_nodes * sizeof *t->nodes + t->cap_box * sizeof *t->box +
-           t->cap_next * sizeof *t->next;
-}
-
 int vpdsi_kd_reserve(vpdsi_kdtree *t, vpdsi_mem *m, size_t n_total, size_t more)
 {
     size_t nodes = t->n_nodes + 2 * more + 1, boxes;
@@ -127,11 +121,7 @@ void vpdsi_kd_insert(vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i)
     t->next[i] = t->nodes[n].head;
     t->nodes[n].head = i;
     t->nodes[n].count++;
-    if (depth > t->depth) t->depth = depth;
-    if (t->nodes[n].count > VPDSI_KD_LEAF && depth < VPDSI_KD_MAX_DEPTH) {
-        leaf_split(t, s, n);
-        if (t->nodes[n].left >= 0 && depth + 1 > t->depth) t->depth = depth + 1;
-    }
+    if (t->nodes[n].count > VPDSI_KD_LEAF && depth < VPDSI_KD_MAX_DEPTH) leaf_split(t, s, n);
 }
 
 double vpdsi_box_mindist2(const double *p, const double *lo, const double *hi, int dim)

@@ -32,7 +32,6 @@ typedef struct vpdsi_kdtree {
     size_t cap_box;
     int32_t *next; /* per sample: next sample in the same leaf, -1 at the end */
     size_t cap_next;
-    int depth;
 } vpdsi_kdtree;
 
 /* The samples the tree indexes (owned by the sampler, which may move them). */
@@ -48,7 +47,6 @@ void vpdsi_kd_release(vpdsi_kdtree *t, vpdsi_mem *m);
 int vpdsi_kd_reserve(vpdsi_kdtree *t, vpdsi_mem *m, size_t n_total, size_t more);
 /* Insert sample i (after vpdsi_kd_reserve). Never allocates. */
 void vpdsi_kd_insert(vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i);
-size_t vpdsi_kd_bytes(const vpdsi_kdtree *t);
 
 /* Conflict: the first sample x (in search order) with |y - x| < scale * f(r(x), ry), or -1.
  * f is the rule (ry unused for prior). Covers PiX (prior), XiP (current), and their "or"

@@ -22,7 +22,6 @@ void vpdsi_mps_reset(vpds_sampler *s, double t)
     s->run.phase = VPDSI_IDLE;
     s->run.t = t;
     s->stats.t = t;
-    s->stats.maximal = 0;
 }
 
 void vpdsi_mps_release(vpds_sampler *s)
@@ -45,15 +44,13 @@ static uint64_t darts_for(uint64_t cells, unsigned level)
     return n < 1 ? 1 : (uint64_t)n;
 }
 
-/* Base grid for the current scale: cells of diagonal t*coverage*r_max, so that in the uniform
- * case a sample covers its whole cell. */
-/* The background grid serves a uniform radius in low dimension; the kd-tree everything else. */
+/* The background grid serves a uniform radius in low dimension; the kd-tree everything else.
+ * (vpdsi_bgrid_setup releases the grid of an earlier scale; the kd-tree path releases it below.) */
 static vpds_status choose_index(vpds_sampler *s)
 {
     vpdsi_run *run = &s->run;
     double reach = run->t * s->inhibition * s->sizing.radius;
     size_t i;
-    vpdsi_bgrid_release(&s->grid, &s->mem);
     s->grid_mode = 0;
     if (s->sizing.kind == VPDSI_SIZING_CONSTANT && s->n_fixed == 0 && s->dim <= 3 &&
         vpdsi_bgrid_setup(&s->grid, &s->mem, s->dim, run->n0, s->lo, run->side0, reach) == 0 &&
@@ -67,6 +64,8 @@ static vpds_status choose_index(vpds_sampler *s)
     return vpdsi_sync_tree(s);
 }
 
+/* Base grid for the current scale: cells of diagonal t*coverage*r_max, so that in the uniform
+ * case a sample covers its whole cell. */
 static vpds_status setup(vpds_sampler *s)
 {
     vpdsi_run *run = &s->run;
@@ -461,10 +460,7 @@ vpds_status vpdsi_mps_run(vpds_sampler *s)
     }
     for (;;) {
         uint64_t limit = CHUNK, before;
-        if (run->phase == VPDSI_DONE) {
-            s->stats.maximal = 1;
-            return VPDS_OK;
-        }
+        if (run->phase == VPDSI_DONE) return VPDS_OK;
         if (s->budget && work >= s->budget) return VPDS_PAUSED;
         if (s->budget && s->budget - work < limit) limit = s->budget - work;
         switch (run->phase) {
@@ -502,10 +498,8 @@ vpds_status vpdsi_mps_run(vpds_sampler *s)
             p.active_cells = run->phase == VPDSI_DONE ? 0 : cur_count(s);
             p.level = cur_level(s);
             p.t = run->t;
-            if (s->progress(&p, s->progress_user) != 0) {
-                if (run->phase == VPDSI_DONE) s->stats.maximal = 1;
+            if (s->progress(&p, s->progress_user) != 0)
                 return run->phase == VPDSI_DONE ? VPDS_OK : VPDS_PAUSED;
-            }
         }
     }
 }
