@@ -43,6 +43,11 @@ extern "C" {
 #define VPDS_ALGORITHM_VERSION 1
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 8
+/* Relative tolerance eps of the continuous stream (vpds_next): each t it reports is an upper
+ * bound of the scale at which the earlier samples stop being maximal, and the point inserted
+ * there is within t * (1 - eps) * inhibition * f of them at worst (exact with two radii when
+ * inhibition <= coverage * (1 - eps)). */
+#define VPDS_STREAM_TOLERANCE 1e-6
 /* Value of vpds_desc.lipschitz meaning "not given". */
 #define VPDS_UNSET (-1.0)
 

@@ -53,9 +53,6 @@ vpds_status vpds_validate(const vpds_desc *d, char *msg, size_t cap)
             REFUSE(VPDS_ERR_OVERFLOW, "desc axis %d: lo = %g, hi = %g; coordinates must stay within "
                    "1e150 in magnitude and the extent at least 1e-150 (squared distances overflow "
                    "or underflow beyond)", k, lo, hi);
-        if (d->periodic && d->periodic[k])
-            REFUSE(VPDS_ERR_UNSUPPORTED, "desc.periodic[%d] = %d: periodic axes are not supported by "
-                   "this version", k, d->periodic[k]);
     }
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
         REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.allocator: alloc and free must both be set or both NULL");
@@ -71,9 +68,6 @@ vpds_status vpds_validate(const vpds_desc *d, char *msg, size_t cap)
     if (d->inhibition > d->coverage)
         REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.inhibition = %g > desc.coverage = %g: need R_f <= R_c",
                d->inhibition, d->coverage);
-    if (d->inhibition != d->coverage)
-        REFUSE(VPDS_ERR_UNSUPPORTED, "desc.inhibition = %g != desc.coverage = %g: two radii are not "
-               "supported by this version", d->inhibition, d->coverage);
     if (d->domain)
         REFUSE(VPDS_ERR_UNSUPPORTED, "desc.domain: domains other than the box are not supported by "
                "this version");
@@ -124,6 +118,15 @@ vpds_status vpds_validate(const vpds_desc *d, char *msg, size_t cap)
         REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.lipschitz: coverage * L = %g * %g = %g is at or above "
                "the %s rule's limit %g (Table 1)", d->coverage, L, d->coverage * L,
                vpdsi_rule_name(d->rule == VPDS_RULE_DEFAULT ? VPDS_RULE_SMALLER : d->rule), limit);
+    if (d->periodic && !callback && !d->sizing_grid) {
+        for (k = 0; k < d->dim; k++) {
+            double side = (d->hi ? d->hi[k] : 1.0) - (d->lo ? d->lo[k] : 0.0);
+            if (d->periodic[k] && !(side > 2 * d->coverage * d->radius))
+                REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.periodic[%d]: the side %g is not above 2 * "
+                       "coverage * radius = %g (a disk would meet its own image across the wrap)",
+                       k, side, 2 * d->coverage * d->radius);
+        }
+    }
     if (d->weighted && callback && !(d->radius_min > 0))
         REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.weighted with a sizing callback needs desc.radius_min "
                "> 0 (a lower bound of r: darts are kept with probability (radius_min / r)^dim)");

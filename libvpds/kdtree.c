@@ -1,5 +1,6 @@
 #include "kdtree.h"
 #include "rules.h"
+#include "torus.h"
 #include <math.h>
 #include <string.h>
 
@@ -13,12 +14,21 @@ void vpdsi_kd_init(vpdsi_kdtree *t, int dim)
     t->dim = dim;
 }
 
+void vpdsi_kd_set_period(vpdsi_kdtree *t, const double *period)
+{
+    int k;
+    for (k = 0; k < t->dim; k++) t->period[k] = period ? period[k] : 0.0;
+}
+
 void vpdsi_kd_release(vpdsi_kdtree *t, vpdsi_mem *m)
 {
     vpdsi_mem_free(m, t->nodes, t->cap_nodes * sizeof *t->nodes);
     vpdsi_mem_free(m, t->box, t->cap_box * sizeof *t->box);
     vpdsi_mem_free(m, t->next, t->cap_next * sizeof *t->next);
-    vpdsi_kd_init(t, t->dim);
+    t->nodes = NULL;
+    t->box = NULL;
+    t->next = NULL;
+    t->n_nodes = t->cap_nodes = t->cap_box = t->cap_next = 0;
 }
 
 int vpdsi_kd_reserve(vpdsi_kdtree *t, vpdsi_mem *m, size_t n_total, size_t more)
@@ -124,40 +134,29 @@ void vpdsi_kd_insert(vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i)
     if (t->nodes[n].count > VPDSI_KD_LEAF && depth < VPDSI_KD_MAX_DEPTH) leaf_split(t, s, n);
 }
 
-double vpdsi_box_mindist2(const double *p, const double *lo, const double *hi, int dim)
+double vpdsi_box_mindist2(const vpdsi_kdtree *t, const double *p, const double *lo, const double *hi)
 {
     double s = 0;
     int k;
-    for (k = 0; k < dim; k++) {
-        double e = 0;
-        if (p[k] < lo[k]) e = lo[k] - p[k];
-        else if (p[k] > hi[k]) e = p[k] - hi[k];
+    for (k = 0; k < t->dim; k++) {
+        double e = vpdsi_axis_gap(p[k], lo[k], hi[k], t->period[k]);
         s += e * e;
     }
     return s;
 }
 
-double vpdsi_box_maxdist2(const double *p, const double *lo, const double *hi, int dim)
+double vpdsi_box_maxdist2(const vpdsi_kdtree *t, const double *p, const double *lo, const double *hi)
 {
     double s = 0;
     int k;
-    for (k = 0; k < dim; k++) {
-        double a = p[k] - lo[k], b = hi[k] - p[k], e = a > b ? a : b;
+    for (k = 0; k < t->dim; k++) {
+        double e = vpdsi_axis_far(p[k], lo[k], hi[k], t->period[k]);
         s += e * e;
     }
     return s;
 }
 
-static double dist2(const double *a, const double *b, int dim)
-{
-    double s = 0;
-    int k;
-    for (k = 0; k < dim; k++) {
-        double e = a[k] - b[k];
-        s += e * e;
-    }
-    return s;
-}
+#define dist2(a, b, dim) vpdsi_torus_dist2((a), (b), (dim), t->period)
 
 int32_t vpdsi_kd_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *y,
                           double ry, int rule, double scale, double lipschitz, int32_t *witness)
@@ -170,7 +169,7 @@ int32_t vpdsi_kd_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, cons
         int32_t n = stack[--top];
         const vpdsi_kd_node *nd = &t->nodes[n];
         double reach = scale * vpdsi_rule_f((vpds_rule)rule, nd->rmax, ry);
-        if (vpdsi_box_mindist2(y, BOX_LO(t, n), BOX_HI(t, n), d) >= reach * reach) continue;
+        if (vpdsi_box_mindist2(t, y, BOX_LO(t, n), BOX_HI(t, n)) >= reach * reach) continue;
         if (nd->left < 0) {
             int32_t i;
             for (i = nd->head; i >= 0; i = t->next[i]) {
@@ -205,10 +204,9 @@ static int push_index(vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap, i
 
 /* Lower bound of the farthest distance, along one axis, from a point of [a, b] to the nearest
  * sub-interval (centres c0, c1 of half-width w). */
-static double far_bound(double a, double b, double c0, double c1, double w)
+static double far_bound(double a, double b, double c0, double c1, double w, double P)
 {
-    double g0 = c0 < a ? a - c0 : c0 > b ? c0 - b : 0;
-    double g1 = c1 < a ? a - c1 : c1 > b ? c1 - b : 0;
+    double g0 = vpdsi_axis_gap(c0, a, b, P), g1 = vpdsi_axis_gap(c1, a, b, P);
     return w + (g0 < g1 ? g0 : g1);
 }
 
@@ -238,7 +236,7 @@ int vpdsi_kd_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const doub
         const double *blo = BOX_LO(t, n), *bhi = BOX_HI(t, n);
         double reach = scale * vpdsi_rule_f((vpds_rule)rule, nd->rmax, r_hi), need = 0;
         for (k = 0; k < d; k++) {
-            double f = far_bound(blo[k], bhi[k], c0[k], c1[k], w[k]);
+            double f = far_bound(blo[k], bhi[k], c0[k], c1[k], w[k], t->period[k]);
             need += f * f;
         }
         if (need > reach * reach) continue;
@@ -249,7 +247,7 @@ int vpdsi_kd_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const doub
                 double f = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_hi);
                 need = 0;
                 for (k = 0; k < d; k++) {
-                    double fb = far_bound(x[k], x[k], c0[k], c1[k], w[k]);
+                    double fb = far_bound(x[k], x[k], c0[k], c1[k], w[k], t->period[k]);
                     need += fb * fb;
                 }
                 if (need > f * f) continue;
@@ -274,7 +272,7 @@ int vpdsi_kd_radius(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const doub
     while (top > 0) {
         int32_t n = stack[--top];
         const vpdsi_kd_node *nd = &t->nodes[n];
-        if (vpdsi_box_mindist2(p, BOX_LO(t, n), BOX_HI(t, n), d) > r2) continue;
+        if (vpdsi_box_mindist2(t, p, BOX_LO(t, n), BOX_HI(t, n)) > r2) continue;
         if (nd->left < 0) {
             int32_t i;
             for (i = nd->head; i >= 0; i = t->next[i])
@@ -289,15 +287,50 @@ int vpdsi_kd_radius(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const doub
     return 0;
 }
 
-int vpdsi_kd_box_covered(const vpdsi_kd_samples *s, int dim, const int32_t *cand, size_t n,
-                         const double *lo, const double *hi, double r_lo, int rule, double scale)
+int vpdsi_kd_box_covered(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *cand,
+                         size_t n, const double *lo, const double *hi, double r_lo, int rule,
+                         double scale)
 {
     size_t j;
     for (j = 0; j < n; j++) {
         int32_t i = cand[j];
         double f = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_lo);
-        if (f > 0 && vpdsi_box_maxdist2(s->x + (size_t)i * (size_t)dim, lo, hi, dim) <= f * f)
+        if (f > 0 && vpdsi_box_maxdist2(t, s->x + (size_t)i * (size_t)t->dim, lo, hi) <= f * f)
             return 1;
     }
     return 0;
+}
+
+double vpdsi_kd_min_ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *y,
+                          double slack, double ry, int rule, int32_t *arg)
+{
+    int32_t stack[STACK_MAX];
+    int top = 0, d = t->dim;
+    double best = INFINITY;
+    *arg = -1;
+    if (t->n_nodes == 0) return best;
+    stack[top++] = 0;
+    while (top > 0) {
+        int32_t n = stack[--top];
+        const vpdsi_kd_node *nd = &t->nodes[n];
+        double f = vpdsi_rule_f((vpds_rule)rule, nd->rmax, ry);
+        /* f is monotone in r(x): no sample of the node does better than its largest radius */
+        if ((sqrt(vpdsi_box_mindist2(t, y, BOX_LO(t, n), BOX_HI(t, n))) + slack) >= best * f) continue;
+        if (nd->left < 0) {
+            int32_t i;
+            for (i = nd->head; i >= 0; i = t->next[i]) {
+                double fi = vpdsi_rule_f((vpds_rule)rule, s->r[i], ry);
+                double q = (sqrt(dist2(y, s->x + (size_t)i * d, d)) + slack) / fi;
+                if (q < best) {
+                    best = q;
+                    *arg = i;
+                }
+            }
+        } else {
+            int near = y[nd->axis] < nd->split;
+            stack[top++] = near ? nd->right : nd->left;
+            stack[top++] = near ? nd->left : nd->right;
+        }
+    }
+    return best;
 }

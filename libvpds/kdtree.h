@@ -26,6 +26,7 @@ typedef struct vpdsi_kd_node {
 
 typedef struct vpdsi_kdtree {
     int dim;
+    double period[VPDS_MAX_DIM]; /* box side on a periodic axis, 0 on an open one (torus.h) */
     vpdsi_kd_node *nodes;
     size_t n_nodes, cap_nodes;
     double *box; /* per node: dim lows then dim highs */
@@ -42,6 +43,8 @@ typedef struct vpdsi_kd_samples {
 } vpdsi_kd_samples;
 
 void vpdsi_kd_init(vpdsi_kdtree *t, int dim);
+/* Measure distances on a torus along the axes with period[k] > 0 (NULL: none). */
+void vpdsi_kd_set_period(vpdsi_kdtree *t, const double *period);
 void vpdsi_kd_release(vpdsi_kdtree *t, vpdsi_mem *m);
 /* Room to insert up to `more` samples, the tree then holding `n_total` samples. */
 int vpdsi_kd_reserve(vpdsi_kdtree *t, vpdsi_mem *m, size_t n_total, size_t more);
@@ -68,14 +71,23 @@ int vpdsi_kd_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const doub
 /* BiX (prior) / XiB (current) and their combinations, on candidates from vpdsi_kd_gather:
  * whether one candidate covers the whole box, |y - x| <= scale * f(r(x), r_lo) for every y in
  * it, r_lo bounding r over the box from below. The farthest corner is tested exactly. */
-int vpdsi_kd_box_covered(const vpdsi_kd_samples *s, int dim, const int32_t *cand, size_t n,
-                         const double *lo, const double *hi, double r_lo, int rule, double scale);
+int vpdsi_kd_box_covered(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *cand,
+                         size_t n, const double *lo, const double *hi, double r_lo, int rule,
+                         double scale);
+
+/* The weighted nearest sample for the continuous stream (Section 4.2): the smallest
+ * (|y - x| + slack) / f(r(x), ry) over all samples, with its index in *arg (-1: no sample, the
+ * result is +INFINITY). With slack = 0 and ry = r(y) this is g(y) * coverage; with slack the
+ * half-diagonal of a box around y and ry a lower bound of r there, it bounds g over the box. */
+double vpdsi_kd_min_ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *y,
+                          double slack, double ry, int rule, int32_t *arg);
 
 /* All samples with |x - p| <= radius, appended to *out; -1 on OOM. */
 int vpdsi_kd_radius(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *p,
                     double radius, vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap);
 
-/* Squared distances between a point and a box: nearest and farthest point of the box. */
-double vpdsi_box_mindist2(const double *p, const double *lo, const double *hi, int dim);
-double vpdsi_box_maxdist2(const double *p, const double *lo, const double *hi, int dim);
+/* Squared distances between a point and a box: nearest and farthest point of the box (the
+ * farthest for the image of p that makes it smallest), on the tree's torus. */
+double vpdsi_box_mindist2(const vpdsi_kdtree *t, const double *p, const double *lo, const double *hi);
+double vpdsi_box_maxdist2(const vpdsi_kdtree *t, const double *p, const double *lo, const double *hi);
 #endif

@@ -8,6 +8,8 @@
  * or an exhausted budget can resume to exactly the points of an uninterrupted run. */
 #include "sampler.h"
 #include "rules.h"
+#include "torus.h"
+#include "uncovered.h"
 #include <math.h>
 #include <string.h>
 
@@ -53,6 +55,7 @@ static vpds_status choose_index(vpds_sampler *s)
     size_t i;
     s->grid_mode = 0;
     if (s->sizing.kind == VPDSI_SIZING_CONSTANT && s->n_fixed == 0 && s->dim <= 3 &&
+        !s->two_radii && !s->any_periodic && !s->stream.active &&
         vpdsi_bgrid_setup(&s->grid, &s->mem, s->dim, run->n0, s->lo, run->side0, reach) == 0 &&
         vpdsi_mem_reserve(&s->mem, (void **)&s->cand, &s->cap_cand, s->grid.n_stencil + 1,
                           sizeof(int32_t)) == 0) {
@@ -76,6 +79,13 @@ static vpds_status setup(vpds_sampler *s)
     unsigned max_level = 62;
     for (k = 0; k < d; k++) {
         double ext = s->hi[k] - s->lo[k], cells = ceil(ext / target), mag, min_side;
+        if (s->period[k] > 0 && !(ext > 2 * run->t * s->coverage * s->sizing.rmax)) {
+            /* a disk would meet its own image across the wrap */
+            vpdsi_set_error(s, "periodic axis %d: side %g is not above 2 * t * coverage * r_max ="
+                            " %g (t = %g)", k, ext, 2 * run->t * s->coverage * s->sizing.rmax,
+                            run->t);
+            return VPDS_ERR_INVALID_ARGUMENT;
+        }
         unsigned lev;
         if (!(cells <= 1099511627776.0)) { /* 2^40 per axis */
             vpdsi_set_error(s, "scale t = %g: axis %d of extent %g needs %g base cells of side %g;"
@@ -285,6 +295,19 @@ static vpds_status darts_chunk(vpds_sampler *s, size_t n)
             s->stats.darts += j;
             return VPDS_ERR_LIPSCHITZ;
         }
+        if (hit == -1 && s->two_radii) {
+            /* Section 3.1, first option: the dart must cover a point not yet covered */
+            int found = 0;
+            st = vpdsi_uncovered_in(s, y, y, s->buf_r[j], &found);
+            if (st != VPDS_OK) {
+                s->rng = start; /* keep the darts before this one, as a pause would */
+                draw_darts(s, &s->rng, j, s->buf_x, weighted ? s->buf_u : NULL);
+                s->run.darts_left -= j;
+                s->stats.darts += j;
+                return st;
+            }
+            if (!found) hit = -3;
+        }
         if (hit == -1) {
             vpdsi_append_sample(s, y, s->buf_r[j], s->run.t, 0);
             s->stats.accepted++;
@@ -299,7 +322,7 @@ static int box_covered(const vpds_sampler *s, const double *lo, const double *hi
                        double scale)
 {
     vpdsi_kd_samples view = vpdsi_samples_view(s);
-    return vpdsi_kd_box_covered(&view, s->dim, s->cand, s->n_cand, lo, hi, r_lo, (int)s->rule, scale);
+    return vpdsi_kd_box_covered(&s->tree, &view, s->cand, s->n_cand, lo, hi, r_lo, (int)s->rule, scale);
 }
 
 /* Which of the 2^d children of cell c are covered whole by one candidate. A child's farthest
@@ -324,9 +347,10 @@ static void children_covered(const vpds_sampler *s, unsigned level, const uint64
         double far[VPDS_MAX_DIM][2], least = 0;
         if (!(f > 0)) continue;
         for (k = 0; k < d; k++) {
-            double a = fabs(x[k] - lo[k]), m = fabs(x[k] - mid[k]), z = fabs(x[k] - hi[k]);
-            far[k][0] = (a > m ? a : m) * (a > m ? a : m);
-            far[k][1] = (m > z ? m : z) * (m > z ? m : z);
+            double a = vpdsi_axis_far(x[k], lo[k], mid[k], s->period[k]);
+            double z = vpdsi_axis_far(x[k], mid[k], hi[k], s->period[k]);
+            far[k][0] = a * a;
+            far[k][1] = z * z;
             least += far[k][0] < far[k][1] ? far[k][0] : far[k][1];
         }
         if (least > f2) continue; /* covers no child */
@@ -349,8 +373,11 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
     vpdsi_run *run = &s->run;
     int d = s->dim, k;
     unsigned level = cur_level(s), children = split ? 1u << d : 1u, b;
-    int need_r = vpdsi_rule_uses_y(s->rule) && s->sizing.kind != VPDSI_SIZING_CONSTANT;
-    double scale = run->t * s->coverage, L = s->sizing.lipschitz;
+    int varying = s->sizing.kind != VPDSI_SIZING_CONSTANT;
+    /* r over the cell: for a rule that reads r(y), and for the reach of two radii' V */
+    int need_r = varying && (vpdsi_rule_uses_y(s->rule) || s->two_radii);
+    /* a cell is dropped inside one inhibition disk (with one radius: one coverage disk) */
+    double scale = run->t * s->inhibition, L = s->sizing.lipschitz;
     uint64_t c[VPDS_MAX_DIM], cc[VPDS_MAX_DIM];
     double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
     size_t j, need;
@@ -374,6 +401,7 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
     for (j = 0; j < n; j++) {
         double h = sqrt(cell_box(s, level, (cell_coords(s, run->pos, c), c), lo, hi));
         double r_lo = s->sizing.radius, r_hi = s->sizing.radius;
+        uint64_t covered[4] = {0, 0, 0, 0};
         vpdsi_kd_samples view = vpdsi_samples_view(s);
         if (need_r) {
             r_lo = s->buf_r[j] - L * h / 2;
@@ -389,20 +417,29 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
             vpdsi_set_error(s, "out of memory gathering the samples near a cell");
             return VPDS_ERR_OUT_OF_MEMORY;
         }
-        run->pos++;
-        if (box_covered(s, lo, hi, r_lo, scale)) continue;
-        if (!split) {
-            vpdsi_cells_push(&run->next, d, c);
+        if (box_covered(s, lo, hi, r_lo, scale)) {
+            run->pos++;
             continue;
         }
-        {
-            uint64_t covered[4] = {0, 0, 0, 0};
-            children_covered(s, level, c, r_lo, scale, covered);
+        if (split) children_covered(s, level, c, r_lo, scale, covered);
+        if (s->two_radii) {
+            /* Figure 2: also drop the (child) cells whose V = cell + R_c disk holds no uncovered
+             * point; decided for every child before any is kept, so an error keeps nothing */
             for (b = 0; b < children; b++) {
+                double clo[VPDS_MAX_DIM], chi[VPDS_MAX_DIM];
+                int found;
                 if (covered[b >> 6] >> (b & 63u) & 1u) continue;
-                for (k = 0; k < d; k++) cc[k] = 2 * c[k] + ((b >> k) & 1u);
-                vpdsi_cells_push(&run->next, d, cc);
+                for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
+                cell_box(s, split ? level + 1 : level, cc, clo, chi);
+                if ((st = vpdsi_uncovered_in(s, clo, chi, r_hi, &found)) != VPDS_OK) return st;
+                if (!found) covered[b >> 6] |= UINT64_C(1) << (b & 63u);
             }
+        }
+        run->pos++;
+        for (b = 0; b < children; b++) {
+            if (covered[b >> 6] >> (b & 63u) & 1u) continue;
+            for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
+            vpdsi_cells_push(&run->next, d, cc);
         }
     }
     return VPDS_OK;

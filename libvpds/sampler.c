@@ -26,6 +26,26 @@ vpdsi_kd_samples vpdsi_samples_view(const vpds_sampler *s)
     return v;
 }
 
+vpds_status vpdsi_radius_at(vpds_sampler *s, const double *p, double *r)
+{
+    double q[VPDS_MAX_DIM];
+    int k;
+    if (s->sizing.kind == VPDSI_SIZING_CONSTANT) {
+        *r = s->sizing.radius;
+        return VPDS_OK;
+    }
+    for (k = 0; k < s->dim; k++) {
+        double P = s->period[k];
+        q[k] = p[k];
+        if (P > 0 && (q[k] < s->lo[k] || q[k] >= s->hi[k])) {
+            q[k] = s->lo[k] + fmod(q[k] - s->lo[k], P);
+            if (q[k] < s->lo[k]) q[k] += P;
+            if (q[k] >= s->hi[k]) q[k] = s->lo[k];
+        }
+    }
+    return vpdsi_sizing_eval(&s->sizing, q, 1, r, s->err, sizeof s->err);
+}
+
 vpds_status vpdsi_reserve_samples(vpds_sampler *s, size_t more)
 {
     size_t need = s->n + more, nx;
@@ -94,6 +114,11 @@ vpds_status vpds_create(const vpds_desc *d, vpds_sampler **out)
     s->rule = d->rule == VPDS_RULE_DEFAULT ? VPDS_RULE_SMALLER : d->rule;
     s->inhibition = d->inhibition;
     s->coverage = d->coverage;
+    s->two_radii = d->inhibition < d->coverage;
+    for (k = 0; k < d->dim; k++) {
+        s->period[k] = d->periodic && d->periodic[k] ? s->hi[k] - s->lo[k] : 0.0;
+        if (s->period[k] > 0) s->any_periodic = 1;
+    }
     s->weighted = d->weighted;
     s->budget = d->budget;
     s->progress = d->progress;
@@ -125,6 +150,8 @@ vpds_status vpds_create(const vpds_desc *d, vpds_sampler **out)
     }
     vpdsi_rng_seed(&s->rng, d->seed);
     vpdsi_kd_init(&s->tree, d->dim);
+    vpdsi_kd_set_period(&s->tree, s->period);
+    vpdsi_stream_init(&s->stream);
     s->magic = VPDSI_SAMPLER_MAGIC;
     vpdsi_mps_reset(s, 1.0);
     *out = s;
@@ -143,6 +170,9 @@ void vpds_destroy(vpds_sampler *s)
     vpdsi_mem_free(&s->mem, s->t, s->cap_t * sizeof(double));
     vpdsi_mem_free(&s->mem, s->flags, s->cap_flags);
     vpdsi_mem_free(&s->mem, s->cand, s->cap_cand * sizeof(int32_t));
+    vpdsi_mem_free(&s->mem, s->cand2, s->cap_cand2 * sizeof(int32_t));
+    vpdsi_mem_free(&s->mem, s->bb_stack, s->cap_bb_stack * sizeof(double));
+    vpdsi_stream_release(&s->stream, &s->mem);
     vpdsi_mem_free(&s->mem, s->buf_x, s->cap_buf_x * sizeof(double));
     vpdsi_mem_free(&s->mem, s->buf_r, s->cap_buf_r * sizeof(double));
     vpdsi_mem_free(&s->mem, s->buf_u, s->cap_buf_u * sizeof(double));
@@ -278,10 +308,37 @@ vpds_status vpds_refine(vpds_sampler *s, double t)
 
 vpds_status vpds_next(vpds_sampler *s, double t_min, double *x_out, double *t_out)
 {
-    (void)t_min; (void)x_out; (void)t_out;
+    vpds_status st;
+    double t;
     if (!live(s)) return VPDS_ERR_INVALID_ARGUMENT;
-    vpdsi_set_error(s, "vpds_next: the continuous stream is not supported by this version");
-    return VPDS_ERR_UNSUPPORTED;
+    s->err[0] = 0;
+    if (!x_out || !t_out) {
+        vpdsi_set_error(s, "vpds_next: x_out and t_out must not be NULL");
+        return VPDS_ERR_INVALID_ARGUMENT;
+    }
+    if (isnan(t_min)) {
+        vpdsi_set_error(s, "vpds_next: t_min is NaN");
+        return VPDS_ERR_INVALID_ARGUMENT;
+    }
+    if (s->run.phase != VPDSI_DONE && (s->run.phase != VPDSI_IDLE || has_samples(s))) {
+        vpdsi_set_error(s, "vpds_next: the run at scale %g is not finished; a stream starts from "
+                        "an empty sampler or a maximal one (call vpds_run until VPDS_OK)", s->run.t);
+        return VPDS_ERR_STATE;
+    }
+    if ((st = ensure_rmax(s)) != VPDS_OK) return st;
+    if (s->grid_mode) {
+        s->grid_mode = 0;
+        vpdsi_bgrid_release(&s->grid, &s->mem);
+    }
+    st = vpdsi_stream_next(s, t_min, x_out, &t);
+    if (st != VPDS_OK) return st;
+    *t_out = t;
+    /* the set is now maximal at t (Section 4.2): a later vpds_refine goes below it */
+    vpdsi_mps_release(s);
+    s->run.phase = VPDSI_DONE;
+    s->run.t = t;
+    s->stats.t = t;
+    return VPDS_OK;
 }
 
 vpds_status vpds_add_points(vpds_sampler *s, const double *x, const double *r, size_t n)
@@ -339,8 +396,16 @@ vpds_status vpds_add_points(vpds_sampler *s, const double *x, const double *r, s
         size_t first = s->n;
         vpdsi_kd_samples v;
         for (i = 0; i < n; i++) {
-            memcpy(s->x + (first + i) * (size_t)s->dim, x + i * (size_t)s->dim,
-                   (size_t)s->dim * sizeof(double));
+            double *xi = s->x + (first + i) * (size_t)s->dim;
+            memcpy(xi, x + i * (size_t)s->dim, (size_t)s->dim * sizeof(double));
+            for (k = 0; k < s->dim; k++) {
+                /* on a periodic axis a point outside the box is its image inside */
+                if (s->period[k] > 0 && (xi[k] < s->lo[k] || xi[k] >= s->hi[k])) {
+                    xi[k] = s->lo[k] + fmod(xi[k] - s->lo[k], s->period[k]);
+                    if (xi[k] < s->lo[k]) xi[k] += s->period[k];
+                    if (xi[k] >= s->hi[k]) xi[k] = s->lo[k];
+                }
+            }
             s->r[first + i] = r ? r[i] : s->buf_r[i];
             s->t[first + i] = INFINITY;
             s->flags[first + i] = (uint8_t)(VPDSI_SAMPLE_FIXED | (r ? VPDSI_SAMPLE_OWN_RADIUS : 0u));

@@ -6,6 +6,7 @@
 #include "kdtree.h"
 #include "rng.h"
 #include "sizing.h"
+#include "stream.h"
 
 #define VPDSI_SAMPLER_MAGIC 0x56505353u /* 'VPSS' */
 #define VPDSI_DESC_COOKIE 0x56504431u    /* 'VPD1': layout 1 of vpds_desc */
@@ -39,6 +40,9 @@ struct vpds_sampler {
     double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
     vpds_rule rule;
     double inhibition, coverage;
+    int two_radii;                 /* inhibition < coverage (Section 3) */
+    double period[VPDS_MAX_DIM];   /* box side on a periodic axis, 0 on an open one */
+    int any_periodic;
     int weighted;
     vpdsi_sizing sizing;
     vpdsi_rng rng;
@@ -59,10 +63,13 @@ struct vpds_sampler {
     int grid_mode;
 
     vpdsi_run run;
+    vpdsi_stream stream;
     vpds_stats stats;
 
     /* scratch reused between chunks */
     int32_t *cand; size_t n_cand, cap_cand;
+    int32_t *cand2; size_t n_cand2, cap_cand2; /* uncovered.c, inside a sweep's cell */
+    double *bb_stack; size_t cap_bb_stack;     /* uncovered.c: boxes still to examine */
     double *buf_x; size_t cap_buf_x;
     double *buf_r; size_t cap_buf_r;
     double *buf_u; size_t cap_buf_u; /* weighted mode: the acceptance draw of each dart */
@@ -70,6 +77,8 @@ struct vpds_sampler {
 };
 
 void vpdsi_set_error(vpds_sampler *s, const char *fmt, ...);
+/* r at a point, wrapped into the box on periodic axes (where the sizing is defined). */
+vpds_status vpdsi_radius_at(vpds_sampler *s, const double *p, double *r);
 /* Room for `more` samples in every per-sample array and the tree; nothing changes on failure. */
 vpds_status vpdsi_reserve_samples(vpds_sampler *s, size_t more);
 /* Insert samples [tree_n, n) into the kd-tree (for leaving grid mode). */

@@ -130,11 +130,11 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
                 int ours, ref = 0, ambiguous = 0;
                 cnt = 0;
                 CHECK(vpdsi_kd_gather(&t, &s, lo, hi, rp, rule, 1.0, 0, &m, &out, &cnt, &cap) == 0);
-                ours = vpdsi_kd_box_covered(&s, dim, out, cnt, lo, hi, rp, rule, 1.0);
+                ours = vpdsi_kd_box_covered(&t, &s, out, cnt, lo, hi, rp, rule, 1.0);
                 for (j = 0; j < nf; j++) {
                     int id = f.idx[j];
                     double fr = vpdsi_rule_f((vpds_rule)rule, r[id], rp);
-                    double far2 = vpdsi_box_maxdist2(x + id * dim, lo, hi, dim);
+                    double far2 = vpdsi_box_maxdist2(&t, x + id * dim, lo, hi);
                     if (far2 <= fr * fr) ref = 1;
                     if (in_band(far2, fr)) ambiguous = 1;
                 }

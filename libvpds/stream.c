@@ -1,0 +1,468 @@
+/* Continuous decrease (Section 4.2) by branch-and-bound over cells, in any dimension.
+ *
+ * The next event is t* = max over the box of g(y) = min_i |y - x_i| / (coverage f(x_i, y)):
+ * the set is maximal at every t >= t*. Regions of the box sit in a max-heap keyed by an upper
+ * bound of g over them; the top region is searched (a best-first search inside it) until its
+ * maximum is known to a relative tolerance, or until it falls below the next key and goes back
+ * into the heap. Inserting a sample only lowers g, so stale keys remain upper bounds and every
+ * region is re-searched lazily when it reaches the top. The sample inserted at t* covers the
+ * maximiser y*: y* itself with one radius (farthest-point insertion), else a point drawn
+ * uniformly from those that are free at t* * inhibition and cover y* at t* * coverage. */
+#include "rules.h"
+#include "sampler.h"
+#include "torus.h"
+#include <math.h>
+#include <string.h>
+
+#define STREAM_SPLIT 1.0 /* a region splits while its half-diagonal exceeds STREAM_SPLIT * t * coverage * r */
+
+void vpdsi_stream_init(vpdsi_stream *st)
+{
+    memset(st, 0, sizeof *st);
+    st->last_t = INFINITY;
+}
+
+void vpdsi_stream_release(vpdsi_stream *st, vpdsi_mem *m)
+{
+    vpdsi_mem_free(m, st->heap, st->cap * sizeof(uint64_t));
+    vpdsi_mem_free(m, st->boxes, st->cap_boxes * sizeof(double));
+    vpdsi_mem_free(m, st->buf, st->cap_buf * sizeof(double));
+    vpdsi_stream_init(st);
+}
+
+/* ---- the region heap: records of (key, level, coordinates) ---- */
+
+/* key, level, g at the cached maximiser (-1: none), coordinates[dim], maximiser[dim] */
+static size_t rec_words(const vpds_sampler *s) { return 3 + 2 * (size_t)s->dim; }
+#define REC_COORD 3
+
+static double rec_key(const uint64_t *r)
+{
+    double k;
+    memcpy(&k, r, sizeof k);
+    return k;
+}
+
+static void rec_swap(uint64_t *a, uint64_t *b, size_t w)
+{
+    size_t i;
+    for (i = 0; i < w; i++) {
+        uint64_t t = a[i];
+        a[i] = b[i];
+        b[i] = t;
+    }
+}
+
+/* Push (after a reserve): sift up. */
+static void heap_push(vpds_sampler *s, double key, uint64_t level, const uint64_t *c, double gy,
+                      const double *y)
+{
+    vpdsi_stream *st = &s->stream;
+    size_t w = rec_words(s), i = st->count++;
+    uint64_t *r = st->heap + i * w;
+    memcpy(r, &key, sizeof key);
+    r[1] = level;
+    memcpy(r + 2, &gy, sizeof gy);
+    memcpy(r + REC_COORD, c, (size_t)s->dim * sizeof(uint64_t));
+    if (y) memcpy(r + REC_COORD + s->dim, y, (size_t)s->dim * sizeof(double));
+    while (i > 0) {
+        size_t p = (i - 1) / 2;
+        if (!(rec_key(st->heap + p * w) < rec_key(st->heap + i * w))) break;
+        rec_swap(st->heap + p * w, st->heap + i * w, w);
+        i = p;
+    }
+}
+
+/* Remove the top into out (w words). */
+static void heap_pop(vpds_sampler *s, uint64_t *out)
+{
+    vpdsi_stream *st = &s->stream;
+    size_t w = rec_words(s), i = 0, n;
+    memcpy(out, st->heap, w * sizeof(uint64_t));
+    n = --st->count;
+    if (n == 0) return;
+    memcpy(st->heap, st->heap + n * w, w * sizeof(uint64_t));
+    for (;;) {
+        size_t l = 2 * i + 1, r = l + 1, m = i;
+        if (l < n && rec_key(st->heap + l * w) > rec_key(st->heap + m * w)) m = l;
+        if (r < n && rec_key(st->heap + r * w) > rec_key(st->heap + m * w)) m = r;
+        if (m == i) break;
+        rec_swap(st->heap + m * w, st->heap + i * w, w);
+        i = m;
+    }
+}
+
+static int heap_reserve(vpds_sampler *s, size_t more)
+{
+    vpdsi_stream *st = &s->stream;
+    size_t words;
+    if (vpdsi_mul_size(st->count + more, rec_words(s), &words)) return -1;
+    return vpdsi_mem_reserve(&s->mem, (void **)&st->heap, &st->cap, words, sizeof(uint64_t));
+}
+
+/* Box of a region as centre and half sides; the last region of an axis ends at the face. */
+static void region_box(const vpds_sampler *s, unsigned level, const uint64_t *c, double *centre,
+                       double *half)
+{
+    const vpdsi_stream *st = &s->stream;
+    int k;
+    for (k = 0; k < s->dim; k++) {
+        double side = ldexp(st->side0[k], -(int)level);
+        uint64_t last = (st->n0[k] << level) - 1;
+        double lo = s->lo[k] + (double)c[k] * side;
+        double hi = c[k] == last ? s->hi[k] : s->lo[k] + (double)(c[k] + 1) * side;
+        centre[k] = 0.5 * (lo + hi);
+        half[k] = 0.5 * (hi - lo);
+    }
+}
+
+static vpds_status build_regions(vpds_sampler *s)
+{
+    vpdsi_stream *st = &s->stream;
+    int d = s->dim, k;
+    double side = INFINITY;
+    uint64_t total = 1, i, c[VPDS_MAX_DIM];
+    unsigned bits = 0;
+    for (k = 0; k < d; k++)
+        if (s->hi[k] - s->lo[k] < side) side = s->hi[k] - s->lo[k];
+    for (k = 0; k < d; k++) {
+        double cells = ceil((s->hi[k] - s->lo[k]) / side * (1 - 1e-12));
+        if (cells > 64) cells = 64; /* long boxes: start coarser, regions split on demand */
+        st->n0[k] = cells < 1 ? 1 : (uint64_t)cells;
+        st->side0[k] = (s->hi[k] - s->lo[k]) / (double)st->n0[k];
+        total *= st->n0[k];
+        bits += vpdsi_bit_length(st->n0[k]);
+    }
+    /* coordinates of the finest regions must fit in 64-bit integers, and stay well above
+     * the precision of doubles */
+    st->max_level = 40;
+    for (k = 0; k < d; k++) {
+        unsigned cap = 62 - vpdsi_bit_length(st->n0[k]);
+        if (cap < st->max_level) st->max_level = cap;
+    }
+    (void)bits;
+    if (heap_reserve(s, (size_t)total)) {
+        vpdsi_set_error(s, "out of memory for %llu stream regions", (unsigned long long)total);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < total; i++) {
+        uint64_t rest = i;
+        for (k = 0; k < d; k++) {
+            c[k] = rest % st->n0[k];
+            rest /= st->n0[k];
+        }
+        heap_push(s, INFINITY, 0, c, -1.0, NULL);
+    }
+    st->active = 1;
+    return VPDS_OK;
+}
+
+/* ---- the search inside one region ---- */
+
+/* Exact g at each of n centres (and argmin), and an upper bound of g over the box of half
+ * sides half around each: (|c - x*| + h) / f(r(x*), r(c) - L h), x* the argmin at c. */
+static vpds_status eval_boxes(vpds_sampler *s, const double *centres, size_t n, const double *half,
+                              double *g, double *ub)
+{
+    vpdsi_stream *st = &s->stream;
+    int d = s->dim, k;
+    int need_r = vpdsi_rule_uses_y(s->rule) && s->sizing.kind != VPDSI_SIZING_CONSTANT;
+    double h = 0, L = s->sizing.lipschitz;
+    vpdsi_kd_samples v = vpdsi_samples_view(s);
+    vpds_status e;
+    size_t j;
+    for (k = 0; k < d; k++) h += half[k] * half[k];
+    h = sqrt(h);
+    if (vpdsi_mem_reserve(&s->mem, (void **)&st->buf, &st->cap_buf, n, sizeof(double))) {
+        vpdsi_set_error(s, "out of memory in the stream's search");
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    if (need_r) {
+        if ((e = vpdsi_sizing_eval(&s->sizing, centres, n, st->buf, s->err, sizeof s->err)) != VPDS_OK)
+            return e;
+    } else {
+        for (j = 0; j < n; j++) st->buf[j] = s->sizing.radius;
+    }
+    for (j = 0; j < n; j++) {
+        const double *c = centres + j * (size_t)d;
+        double rc = st->buf[j], r_lo = rc - L * h;
+        int32_t arg;
+        double q = vpdsi_kd_min_ratio(&s->tree, &v, c, 0.0, rc, (int)s->rule, &arg);
+        g[j] = q / s->coverage;
+        if (arg < 0) {
+            ub[j] = INFINITY;
+            continue;
+        }
+        if (!(r_lo > 0)) r_lo = 0;
+        {
+            double dist = sqrt(vpdsi_torus_dist2(c, s->x + (size_t)arg * (size_t)d, d, s->period));
+            double f = vpdsi_rule_f(s->rule, s->r[arg], r_lo);
+            ub[j] = f > 0 ? (dist + h) / (f * s->coverage) : INFINITY;
+        }
+    }
+    return VPDS_OK;
+}
+
+/* Best-first search for the maximum of g over one region, stopped as soon as it is known to
+ * the tolerance (*resolved) or to lie below `floor` (the next region's key). *bound is an
+ * upper bound of g over the region either way; when resolved, g(y) >= *bound / (1 + VPDS_STREAM_TOLERANCE). */
+static vpds_status search_region(vpds_sampler *s, const double *centre, const double *half,
+                                 double floor, double *bound, double *y, double *gy, int *resolved)
+{
+    vpdsi_stream *st = &s->stream;
+    int d = s->dim, k;
+    size_t w = 1 + 2 * (size_t)d, children = (size_t)1 << d, j;
+    double best = -1, extra = -1; /* extra: bounds of boxes no longer searched */
+    double g1, ub1, cs[(1u << VPDS_MAX_DIM) * VPDS_MAX_DIM], gs[1u << VPDS_MAX_DIM],
+        ubs[1u << VPDS_MAX_DIM], mag = 0;
+    vpds_status e;
+    for (k = 0; k < d; k++) {
+        double m = fabs(s->lo[k]) > fabs(s->hi[k]) ? fabs(s->lo[k]) : fabs(s->hi[k]);
+        if (s->hi[k] - s->lo[k] > m) m = s->hi[k] - s->lo[k];
+        if (m > mag) mag = m;
+    }
+    if ((e = eval_boxes(s, centre, 1, half, &g1, &ub1)) != VPDS_OK) return e;
+    best = g1;
+    memcpy(y, centre, (size_t)d * sizeof(double));
+    st->n_boxes = 0;
+    if (vpdsi_mem_reserve(&s->mem, (void **)&st->boxes, &st->cap_boxes, w, sizeof(double))) goto oom;
+    st->boxes[0] = ub1;
+    memcpy(st->boxes + 1, centre, (size_t)d * sizeof(double));
+    memcpy(st->boxes + 1 + d, half, (size_t)d * sizeof(double));
+    st->n_boxes = 1;
+    for (;;) {
+        double top = -1, hb[VPDS_MAX_DIM], cb[VPDS_MAX_DIM], hmax = 0, U;
+        size_t at = 0;
+        /* the open boxes form a small list; a linear scan finds the best (they are few) */
+        for (j = 0; j < st->n_boxes; j++)
+            if (st->boxes[j * w] > top) {
+                top = st->boxes[j * w];
+                at = j;
+            }
+        U = top;
+        if (best > U) U = best;
+        if (extra > U) U = extra;
+        if (U <= best * (1 + VPDS_STREAM_TOLERANCE)) {
+            *bound = U;
+            *gy = best;
+            *resolved = 1;
+            return VPDS_OK;
+        }
+        if (U < floor) {
+            *bound = U;
+            *gy = -1.0;
+            *resolved = 0;
+            return VPDS_OK;
+        }
+        /* take the best box out, split it in 2^d */
+        memcpy(cb, st->boxes + at * w + 1, (size_t)d * sizeof(double));
+        memcpy(hb, st->boxes + at * w + 1 + d, (size_t)d * sizeof(double));
+        memmove(st->boxes + at * w, st->boxes + (st->n_boxes - 1) * w, w * sizeof(double));
+        st->n_boxes--;
+        for (k = 0; k < d; k++) {
+            hb[k] *= 0.5;
+            if (hb[k] > hmax) hmax = hb[k];
+        }
+        if (!(hmax > ldexp(mag, -46))) {
+            /* at the precision of doubles: keep its bound, search no deeper */
+            if (top > extra) extra = top;
+            continue;
+        }
+        for (j = 0; j < children; j++)
+            for (k = 0; k < d; k++)
+                cs[j * (size_t)d + (size_t)k] = cb[k] + ((j >> k) & 1u ? hb[k] : -hb[k]);
+        if ((e = eval_boxes(s, cs, children, hb, gs, ubs)) != VPDS_OK) return e;
+        if (vpdsi_mem_reserve(&s->mem, (void **)&st->boxes, &st->cap_boxes,
+                              (st->n_boxes + children) * w, sizeof(double)))
+            goto oom;
+        for (j = 0; j < children; j++) {
+            if (gs[j] > best) {
+                best = gs[j];
+                memcpy(y, cs + j * (size_t)d, (size_t)d * sizeof(double));
+            }
+        }
+        for (j = 0; j < children; j++) {
+            double *r;
+            if (ubs[j] <= best * (1 + VPDS_STREAM_TOLERANCE)) {
+                /* cannot beat the best by more than the tolerance: keep only its bound */
+                if (ubs[j] > extra) extra = ubs[j];
+                continue;
+            }
+            r = st->boxes + st->n_boxes++ * w;
+            r[0] = ubs[j];
+            memcpy(r + 1, cs + j * (size_t)d, (size_t)d * sizeof(double));
+            memcpy(r + 1 + d, hb, (size_t)d * sizeof(double));
+        }
+    }
+oom:
+    vpdsi_set_error(s, "out of memory in the stream's search");
+    return VPDS_ERR_OUT_OF_MEMORY;
+}
+
+/* ---- the sample of an event ---- */
+
+
+/* Two radii: a point drawn uniformly from those free at t * inhibition whose coverage disk
+ * at t holds y (rejection from the cube around y); y itself if the draws keep failing. */
+static vpds_status draw_near(vpds_sampler *s, double t, const double *y, double ry, double *x,
+                             double *rx)
+{
+    int d = s->dim, k;
+    int uses_x = s->rule == VPDS_RULE_PRIOR || s->rule == VPDS_RULE_BIGGER;
+    double sl = t * s->coverage * s->sizing.lipschitz, rho, diag2 = 0;
+    vpdsi_kd_samples v;
+    long tries, max_tries = 64L << d;
+    vpds_status e;
+    for (k = 0; k < d; k++) diag2 += (s->hi[k] - s->lo[k]) * (s->hi[k] - s->lo[k]);
+    rho = t * s->coverage * ry;
+    if (uses_x) rho = sl < 1 ? rho / (1 - sl) : sqrt(diag2);
+    if (rho * rho > diag2) rho = sqrt(diag2);
+    for (tries = 0; tries < max_tries; tries++) {
+        double d2 = 0, f;
+        int32_t w, hit;
+        int outside = 0;
+        for (k = 0; k < d; k++) {
+            double u = y[k] + (2 * vpdsi_rng_unit(&s->rng) - 1) * rho;
+            d2 += (u - y[k]) * (u - y[k]);
+            if (s->period[k] > 0) {
+                while (u < s->lo[k]) u += s->period[k];
+                while (u >= s->hi[k]) u -= s->period[k];
+            } else if (u < s->lo[k] || u > s->hi[k]) {
+                outside = 1;
+            }
+            x[k] = u;
+        }
+        if (outside || d2 > rho * rho) continue;
+        if ((e = vpdsi_radius_at(s, x, rx)) != VPDS_OK) return e;
+        f = t * s->coverage * vpdsi_rule_f(s->rule, *rx, ry);
+        if (d2 > f * f) continue; /* does not cover y */
+        v = vpdsi_samples_view(s);
+        hit = vpdsi_kd_conflict(&s->tree, &v, x, *rx, (int)s->rule, t * s->inhibition,
+                                s->sizing.kind == VPDSI_SIZING_CONSTANT ? -1.0 : s->sizing.lipschitz, &w);
+        if (hit == -2) {
+            vpdsi_set_error(s, "sizing breaks lipschitz = %g near sample %d", s->sizing.lipschitz, (int)w);
+            return VPDS_ERR_LIPSCHITZ;
+        }
+        if (hit == -1) return VPDS_OK;
+    }
+    memcpy(x, y, (size_t)d * sizeof(double));
+    *rx = ry;
+    return VPDS_OK;
+}
+
+vpds_status vpdsi_stream_next(vpds_sampler *s, double t_min, double *x_out, double *t_out)
+{
+    vpdsi_stream *st = &s->stream;
+    int d = s->dim, k;
+    uint64_t rec[3 + 2 * VPDS_MAX_DIM];
+    vpdsi_rng start = s->rng;
+    vpds_status e;
+    if ((e = vpdsi_sync_tree(s)) != VPDS_OK) return e;
+    if ((e = vpdsi_reserve_samples(s, 1)) != VPDS_OK) return e;
+    if (s->n == 0) {
+        /* the first sample: uniform over the box, at t = +infinity */
+        double x[VPDS_MAX_DIM], r;
+        if (t_min >= INFINITY) return VPDS_STREAM_END;
+        for (k = 0; k < d; k++) {
+            double u = s->lo[k] + vpdsi_rng_unit(&s->rng) * (s->hi[k] - s->lo[k]);
+            x[k] = u > s->hi[k] ? s->hi[k] : u;
+        }
+        if ((e = vpdsi_radius_at(s, x, &r)) != VPDS_OK) {
+            s->rng = start;
+            return e;
+        }
+        vpdsi_append_sample(s, x, r, INFINITY, 0);
+        memcpy(x_out, x, (size_t)d * sizeof(double));
+        *t_out = INFINITY;
+        s->stats.accepted++;
+        return VPDS_OK;
+    }
+    if (!st->active && (e = build_regions(s)) != VPDS_OK) return e;
+    for (;;) {
+        double key, next, centre[VPDS_MAX_DIM], half[VPDS_MAX_DIM], bound, y[VPDS_MAX_DIM], gy;
+        double h = 0;
+        int resolved;
+        unsigned level;
+        uint64_t *c = rec + REC_COORD;
+        key = rec_key(st->heap);
+        if (key <= t_min) return VPDS_STREAM_END; /* every region is below: nothing consumed */
+        if (heap_reserve(s, (size_t)1 << d)) {
+            vpdsi_set_error(s, "out of memory for the stream's regions");
+            return VPDS_ERR_OUT_OF_MEMORY;
+        }
+        heap_pop(s, rec);
+        level = (unsigned)rec[1];
+        memcpy(&gy, rec + 2, sizeof gy);
+        memcpy(y, rec + REC_COORD + d, (size_t)d * sizeof(double));
+        next = st->count ? rec_key(st->heap) : 0.0;
+        region_box(s, level, c, centre, half);
+        for (k = 0; k < d; k++) h += half[k] * half[k];
+        h = sqrt(h);
+        if (isfinite(key) && level < st->max_level) {
+            /* too coarse for the scale of its key: hand its key to its 2^d children */
+            double r;
+            if ((e = vpdsi_radius_at(s, centre, &r)) != VPDS_OK) {
+                heap_push(s, key, level, c, gy, y);
+                return e;
+            }
+            if (h > STREAM_SPLIT * key * s->coverage * (r - s->sizing.lipschitz * h) ||
+                r <= s->sizing.lipschitz * h) {
+                uint64_t b, cc[VPDS_MAX_DIM];
+                for (b = 0; b < ((uint64_t)1 << d); b++) {
+                    int skip = 0;
+                    for (k = 0; k < d; k++) {
+                        cc[k] = 2 * c[k] + ((b >> k) & 1u);
+                        if (cc[k] >= (st->n0[k] << (level + 1))) skip = 1;
+                    }
+                    if (!skip) heap_push(s, key, level + 1, cc, -1.0, NULL);
+                }
+                continue;
+            }
+        }
+        resolved = 0;
+        if (gy >= 0) {
+            /* the cached maximiser still holds if no sample since lowered g there: then the
+             * region's bound is unchanged (samples only lower g) */
+            double g1, ub1, zero[VPDS_MAX_DIM] = {0};
+            if ((e = eval_boxes(s, y, 1, zero, &g1, &ub1)) != VPDS_OK) {
+                heap_push(s, key, level, c, gy, y);
+                return e;
+            }
+            if (g1 == gy) {
+                resolved = 1;
+                bound = key;
+            }
+        }
+        if (!resolved) {
+            e = search_region(s, centre, half, -1.0, &bound, y, &gy, &resolved);
+            if (e != VPDS_OK) {
+                heap_push(s, key, level, c, -1.0, NULL);
+                return e;
+            }
+        }
+        heap_push(s, bound, level, c, gy, y);
+        if (bound < next) continue;
+        {
+            /* an event at t = bound (an upper bound of max g), never above the last one */
+            double t = bound < st->last_t ? bound : st->last_t, x[VPDS_MAX_DIM], rx, ry;
+            if (s->run.phase == VPDSI_DONE && t > s->run.t) t = s->run.t;
+            if (t <= t_min) return VPDS_STREAM_END;
+            if ((e = vpdsi_radius_at(s, y, &ry)) != VPDS_OK) return e;
+            memcpy(x, y, (size_t)d * sizeof(double));
+            rx = ry;
+            if (s->two_radii) {
+                e = draw_near(s, t, y, ry, x, &rx);
+                if (e != VPDS_OK) {
+                    s->rng = start;
+                    return e;
+                }
+            }
+            vpdsi_append_sample(s, x, rx, t, 0);
+            s->stats.accepted++;
+            st->last_t = t;
+            memcpy(x_out, x, (size_t)d * sizeof(double));
+            *t_out = t;
+            return VPDS_OK;
+        }
+    }
+}

@@ -1,0 +1,29 @@
+/* Continuous decrease (Section 4.2): the state of the one-sample-at-a-time stream. */
+#ifndef VPDS_STREAM_H
+#define VPDS_STREAM_H
+#include "mem.h"
+
+/* The box is cut into regions (cells of a lazily refined grid) in a max-heap keyed by an upper
+ * bound of g = distance to the samples over coverage * f, the scale at which a point becomes
+ * covered. Samples only lower g, so a stale key stays an upper bound (DESIGN.md). */
+typedef struct vpdsi_stream {
+    int active;                    /* regions built */
+    uint64_t n0[VPDS_MAX_DIM];     /* level-0 regions per axis */
+    double side0[VPDS_MAX_DIM];
+    unsigned max_level;
+    uint64_t *heap;                /* records of 2 + dim words: key (double), level, coordinates */
+    size_t count, cap;
+    double *boxes;                 /* the search inside one region: key, centre, half sides */
+    size_t n_boxes, cap_boxes;
+    double *buf;                   /* centres and radii of one split */
+    size_t cap_buf;
+    double last_t;                 /* t of the last event: t never increases */
+} vpdsi_stream;
+
+struct vpds_sampler;
+
+void vpdsi_stream_init(vpdsi_stream *st);
+void vpdsi_stream_release(vpdsi_stream *st, vpdsi_mem *m);
+/* One event: the sample and its t, or VPDS_STREAM_END when t <= t_min (nothing consumed). */
+vpds_status vpdsi_stream_next(struct vpds_sampler *s, double t_min, double *x_out, double *t_out);
+#endif
