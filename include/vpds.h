@@ -47,7 +47,7 @@ extern "C" {
  * bound of the scale at which the earlier samples stop being maximal, and the point inserted
  * there is within t * (1 - eps) * inhibition * f of them at worst (exact with two radii when
  * inhibition <= coverage * (1 - eps)). */
-#define VPDS_STREAM_TOLERANCE 1e-6
+#define VPDS_STREAM_TOLERANCE 1e-5
 /* Value of vpds_desc.lipschitz meaning "not given". */
 #define VPDS_UNSET (-1.0)
 

@@ -53,6 +53,13 @@ void vpdsi_cells_push(vpdsi_cells *c, int dim, const uint64_t *coord)
     c->count++;
 }
 
+void vpdsi_cells_move(vpdsi_cells *c, size_t from, size_t to)
+{
+    if (from != to)
+        memcpy(c->words + to * c->words_per_cell, c->words + from * c->words_per_cell,
+               c->words_per_cell * sizeof *c->words);
+}
+
 void vpdsi_cells_get(const vpdsi_cells *c, size_t i, int dim, uint64_t *coord)
 {
     const uint64_t *w = c->words + i * c->words_per_cell;

@@ -20,6 +20,8 @@ void vpdsi_cells_release(vpdsi_cells *c, vpdsi_mem *m);
 /* Append (after reserve; never allocates) and read back. */
 void vpdsi_cells_push(vpdsi_cells *c, int dim, const uint64_t *coord);
 void vpdsi_cells_get(const vpdsi_cells *c, size_t i, int dim, uint64_t *coord);
+/* Copy cell `from` over cell `to` (in-place compaction, to <= from). */
+void vpdsi_cells_move(vpdsi_cells *c, size_t from, size_t to);
 /* Bits needed to hold values below n (at least 1). */
 unsigned vpdsi_bit_length(uint64_t n);
 #endif

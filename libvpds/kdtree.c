@@ -31,6 +31,8 @@ void vpdsi_kd_release(vpdsi_kdtree *t, vpdsi_mem *m)
     t->n_nodes = t->cap_nodes = t->cap_box = t->cap_next = 0;
 }
 
+void vpdsi_kd_clear(vpdsi_kdtree *t) { t->n_nodes = 0; }
+
 int vpdsi_kd_reserve(vpdsi_kdtree *t, vpdsi_mem *m, size_t n_total, size_t more)
 {
     size_t nodes = t->n_nodes + 2 * more + 1, boxes;

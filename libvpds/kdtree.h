@@ -46,6 +46,8 @@ void vpdsi_kd_init(vpdsi_kdtree *t, int dim);
 /* Measure distances on a torus along the axes with period[k] > 0 (NULL: none). */
 void vpdsi_kd_set_period(vpdsi_kdtree *t, const double *period);
 void vpdsi_kd_release(vpdsi_kdtree *t, vpdsi_mem *m);
+/* Forget every sample, keep the memory. */
+void vpdsi_kd_clear(vpdsi_kdtree *t);
 /* Room to insert up to `more` samples, the tree then holding `n_total` samples. */
 int vpdsi_kd_reserve(vpdsi_kdtree *t, vpdsi_mem *m, size_t n_total, size_t more);
 /* Insert sample i (after vpdsi_kd_reserve). Never allocates. */

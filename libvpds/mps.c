@@ -111,6 +111,7 @@ static vpds_status setup(vpds_sampler *s)
     }
     run->base_count = total;
     run->max_level = max_level;
+    s->u_ready = 0;
     if ((st = choose_index(s)) != VPDS_OK) return st;
     run->implicit = 1;
     run->pos = 0;
@@ -298,7 +299,11 @@ static vpds_status darts_chunk(vpds_sampler *s, size_t n)
         if (hit == -1 && s->two_radii) {
             /* Section 3.1, first option: the dart must cover a point not yet covered */
             int found = 0;
-            st = vpdsi_uncovered_in(s, y, y, s->buf_r[j], &found);
+            st = VPDS_OK;
+            if (vpdsi_uncovered_nearest(s, y) > vpdsi_coverage_reach(s, s->buf_r[j]) + s->u_half)
+                found = 0; /* no cell that may hold an uncovered point is within reach */
+            else
+                st = vpdsi_uncovered_in(s, y, y, s->buf_r[j], &found);
             if (st != VPDS_OK) {
                 s->rng = start; /* keep the darts before this one, as a pause would */
                 draw_darts(s, &s->rng, j, s->buf_x, weighted ? s->buf_u : NULL);
@@ -335,7 +340,7 @@ static void children_covered(const vpds_sampler *s, unsigned level, const uint64
     int d = s->dim, k;
     unsigned children = 1u << d, b;
     double lo[VPDS_MAX_DIM], mid[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], sums[1u << VPDS_MAX_DIM];
-    uint64_t cc[VPDS_MAX_DIM];
+    uint64_t cc[VPDS_MAX_DIM] = {0};
     size_t j;
     for (k = 0; k < d; k++) cc[k] = 2 * c[k];
     cell_box(s, level + 1, cc, lo, mid);
@@ -383,7 +388,9 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
     size_t j, need;
     vpds_status st;
     if (vpdsi_mul_size(n, children, &need) ||
-        vpdsi_cells_reserve(&run->next, &s->mem, run->next.count + need)) {
+        vpdsi_cells_reserve(&run->next, &s->mem, run->next.count + need) ||
+        (s->two_radii && vpdsi_mem_reserve(&s->mem, (void **)&s->next_u, &s->cap_next_u,
+                                           run->next.count + need, 1))) {
         vpdsi_set_error(s, "out of memory for the active cells of level %u", run->next.level);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
@@ -412,7 +419,8 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
             uint64_t base[VPDS_MAX_DIM];
             for (k = 0; k < d; k++) base[k] = c[k] >> level; /* the base cell holding this one */
             s->n_cand = vpdsi_bgrid_near(&s->grid, vpdsi_bgrid_index(&s->grid, base), s->cand);
-        } else if (vpdsi_kd_gather(&s->tree, &view, lo, hi, r_hi, (int)s->rule, scale, split,
+        } else if (vpdsi_kd_gather(&s->tree, &view, lo, hi, r_hi, (int)s->rule,
+                                   s->two_radii ? run->t * s->coverage : scale, split,
                                    &s->mem, &s->cand, &s->n_cand, &s->cap_cand)) {
             vpdsi_set_error(s, "out of memory gathering the samples near a cell");
             return VPDS_ERR_OUT_OF_MEMORY;
@@ -423,17 +431,36 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
         }
         if (split) children_covered(s, level, c, r_lo, scale, covered);
         if (s->two_radii) {
-            /* Figure 2: also drop the (child) cells whose V = cell + R_c disk holds no uncovered
-             * point; decided for every child before any is kept, so an error keeps nothing */
+            /* which kept children may hold an uncovered point: not inside one coverage disk
+             * (the gather above, at the larger coverage reach, found every candidate), and
+             * not shown covered by a search inside them; decided before anything is kept */
+            uint64_t cov_c[4] = {0, 0, 0, 0};
+            uint8_t flag[1u << VPDS_MAX_DIM];
+            double scale_c = run->t * s->coverage;
+            if (box_covered(s, lo, hi, r_lo, scale_c)) {
+                cov_c[0] = cov_c[1] = cov_c[2] = cov_c[3] = ~UINT64_C(0);
+            } else if (split) {
+                children_covered(s, level, c, r_lo, scale_c, cov_c);
+            }
             for (b = 0; b < children; b++) {
                 double clo[VPDS_MAX_DIM], chi[VPDS_MAX_DIM];
-                int found;
-                if (covered[b >> 6] >> (b & 63u) & 1u) continue;
+                int found = 0;
+                flag[b] = 0;
+                if ((covered[b >> 6] >> (b & 63u) & 1u) || (cov_c[b >> 6] >> (b & 63u) & 1u))
+                    continue;
                 for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
                 cell_box(s, split ? level + 1 : level, cc, clo, chi);
-                if ((st = vpdsi_uncovered_in(s, clo, chi, r_hi, &found)) != VPDS_OK) return st;
-                if (!found) covered[b >> 6] |= UINT64_C(1) << (b & 63u);
+                if ((st = vpdsi_uncovered_in(s, clo, chi, 0.0, &found)) != VPDS_OK) return st;
+                flag[b] = (uint8_t)found;
             }
+            run->pos++;
+            for (b = 0; b < children; b++) {
+                if (covered[b >> 6] >> (b & 63u) & 1u) continue;
+                s->next_u[run->next.count] = flag[b];
+                for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
+                vpdsi_cells_push(&run->next, d, cc);
+            }
+            continue;
         }
         run->pos++;
         for (b = 0; b < children; b++) {
@@ -441,6 +468,43 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
             for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
             vpdsi_cells_push(&run->next, d, cc);
         }
+    }
+    return VPDS_OK;
+}
+
+/* Two radii (Figure 2): keep a new cell only if a cell that may hold an uncovered point lies
+ * within the coverage reach of it; kept cells are compacted in place, in order. */
+static vpds_status vfilter_chunk(vpds_sampler *s, size_t n)
+{
+    vpdsi_run *run = &s->run;
+    int d = s->dim, k;
+    int varying = s->sizing.kind != VPDSI_SIZING_CONSTANT;
+    uint64_t c[VPDS_MAX_DIM];
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], centre[VPDS_MAX_DIM];
+    size_t j;
+    vpds_status st;
+    if (!s->u_ready && (st = vpdsi_uncovered_index(s)) != VPDS_OK) return st;
+    if (varying) {
+        if ((st = reserve_buffers(s, n)) != VPDS_OK) return st;
+        for (j = 0; j < n; j++) {
+            vpdsi_cells_get(&run->next, (size_t)run->vpos + j, d, c);
+            cell_box(s, run->next.level, c, lo, hi);
+            for (k = 0; k < d; k++) s->buf_x[j * (size_t)d + (size_t)k] = 0.5 * (lo[k] + hi[k]);
+        }
+        st = vpdsi_sizing_eval(&s->sizing, s->buf_x, n, s->buf_r, s->err, sizeof s->err);
+        if (st != VPDS_OK) return st;
+    }
+    for (j = 0; j < n; j++) {
+        size_t i = (size_t)run->vpos;
+        double h = 0.5 * sqrt(cell_box(s, run->next.level, (vpdsi_cells_get(&run->next, i, d, c), c), lo, hi));
+        double r_hi = varying ? s->buf_r[j] + s->sizing.lipschitz * h : s->sizing.radius;
+        for (k = 0; k < d; k++) centre[k] = 0.5 * (lo[k] + hi[k]);
+        if (vpdsi_uncovered_nearest(s, centre) <= vpdsi_coverage_reach(s, r_hi) + h + s->u_half) {
+            vpdsi_cells_move(&run->next, i, (size_t)run->wpos);
+            s->next_u[run->wpos] = s->next_u[i];
+            run->wpos++;
+        }
+        run->vpos++;
     }
     return VPDS_OK;
 }
@@ -510,7 +574,31 @@ vpds_status vpdsi_mps_run(vpds_sampler *s)
             st = sweep_chunk(s, (size_t)limit, split);
             work += run->pos - before;
             if (st != VPDS_OK) return st;
-            if (run->pos == total) finish_sweep(s, split);
+            if (run->pos == total) {
+                if (s->two_radii) {
+                    run->vsplit = split | (run->phase == VPDSI_FILTER ? 2 : 0);
+                    run->vpos = run->wpos = 0;
+                    s->u_ready = 0;
+                    run->phase = VPDSI_VFILTER;
+                } else {
+                    finish_sweep(s, split);
+                }
+            }
+            break;
+        }
+        case VPDSI_VFILTER: {
+            uint64_t total = run->next.count;
+            before = run->vpos;
+            if (total - run->vpos < limit) limit = total - run->vpos;
+            st = vfilter_chunk(s, (size_t)limit);
+            work += run->vpos - before;
+            if (st != VPDS_OK) return st;
+            if (run->vpos == total) {
+                run->next.count = (size_t)run->wpos;
+                /* finish_sweep tells a precision stop by the phase: restore the sweep's */
+                run->phase = run->vsplit & 2 ? VPDSI_FILTER : VPDSI_SWEEP;
+                finish_sweep(s, run->vsplit & 1);
+            }
             break;
         }
         case VPDSI_DARTS:

@@ -151,6 +151,8 @@ vpds_status vpds_create(const vpds_desc *d, vpds_sampler **out)
     vpdsi_rng_seed(&s->rng, d->seed);
     vpdsi_kd_init(&s->tree, d->dim);
     vpdsi_kd_set_period(&s->tree, s->period);
+    vpdsi_kd_init(&s->utree, d->dim);
+    vpdsi_kd_set_period(&s->utree, s->period);
     vpdsi_stream_init(&s->stream);
     s->magic = VPDSI_SAMPLER_MAGIC;
     vpdsi_mps_reset(s, 1.0);
@@ -172,6 +174,11 @@ void vpds_destroy(vpds_sampler *s)
     vpdsi_mem_free(&s->mem, s->cand, s->cap_cand * sizeof(int32_t));
     vpdsi_mem_free(&s->mem, s->cand2, s->cap_cand2 * sizeof(int32_t));
     vpdsi_mem_free(&s->mem, s->bb_stack, s->cap_bb_stack * sizeof(double));
+    vpdsi_mem_free(&s->mem, s->next_u, s->cap_next_u);
+    vpdsi_kd_release(&s->utree, &s->mem);
+    vpdsi_mem_free(&s->mem, s->ux, s->cap_ux * sizeof(double));
+    vpdsi_mem_free(&s->mem, s->ur, s->cap_ur * sizeof(double));
+    vpdsi_mem_free(&s->mem, s->uf, s->cap_uf);
     vpdsi_stream_release(&s->stream, &s->mem);
     vpdsi_mem_free(&s->mem, s->buf_x, s->cap_buf_x * sizeof(double));
     vpdsi_mem_free(&s->mem, s->buf_r, s->cap_buf_r * sizeof(double));

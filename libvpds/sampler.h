@@ -16,6 +16,7 @@ typedef enum {
     VPDSI_FILTER, /* dropping base cells covered by samples that existed before the run */
     VPDSI_DARTS,  /* throwing the darts of the current level */
     VPDSI_SWEEP,  /* coverage sweep: splitting active cells, keeping uncovered children */
+    VPDSI_VFILTER, /* two radii: dropping the new cells whose R_c-neighbourhood is covered */
     VPDSI_DONE    /* maximal at the current scale */
 } vpdsi_phase;
 
@@ -31,6 +32,8 @@ typedef struct vpdsi_run {
     vpdsi_cells cur, next;
     uint64_t pos;                  /* cells of cur swept so far */
     uint64_t darts_left;           /* darts still to throw at this level */
+    uint64_t vpos, wpos;           /* VFILTER: cells of next read, cells kept */
+    int vsplit;                    /* VFILTER: bit 0 the sweep split, bit 1 it was FILTER */
 } vpdsi_run;
 
 struct vpds_sampler {
@@ -70,6 +73,15 @@ struct vpds_sampler {
     int32_t *cand; size_t n_cand, cap_cand;
     int32_t *cand2; size_t n_cand2, cap_cand2; /* uncovered.c, inside a sweep's cell */
     double *bb_stack; size_t cap_bb_stack;     /* uncovered.c: boxes still to examine */
+    /* two radii: the cells of run.next not inside one coverage disk hold every uncovered
+     * point; a kd-tree of their centres answers "is U near?" (uncovered.c) */
+    uint8_t *next_u; size_t cap_next_u;
+    vpdsi_kdtree utree;
+    double *ux; size_t cap_ux;
+    double *ur; size_t cap_ur;
+    uint8_t *uf; size_t cap_uf;
+    double u_half;   /* largest half-diagonal of those cells */
+    int u_ready;     /* utree describes the current cells */
     double *buf_x; size_t cap_buf_x;
     double *buf_r; size_t cap_buf_r;
     double *buf_u; size_t cap_buf_u; /* weighted mode: the acceptance draw of each dart */

@@ -195,9 +195,14 @@ static vpds_status eval_boxes(vpds_sampler *s, const double *centres, size_t n, 
         }
         if (!(r_lo > 0)) r_lo = 0;
         {
-            double dist = sqrt(vpdsi_torus_dist2(c, s->x + (size_t)arg * (size_t)d, d, s->period));
-            double f = vpdsi_rule_f(s->rule, s->r[arg], r_lo);
-            ub[j] = f > 0 ? (dist + h) / (f * s->coverage) : INFINITY;
+            /* the farthest point of the box from x* (nearest image), tighter than |c - x*| + h */
+            const double *xa = s->x + (size_t)arg * (size_t)d;
+            double far2 = 0, f = vpdsi_rule_f(s->rule, s->r[arg], r_lo);
+            for (k = 0; k < d; k++) {
+                double e = vpdsi_axis_far(xa[k], c[k] - half[k], c[k] + half[k], s->period[k]);
+                far2 += e * e;
+            }
+            ub[j] = f > 0 ? sqrt(far2) / (f * s->coverage) : INFINITY;
         }
     }
     return VPDS_OK;

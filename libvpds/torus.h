@@ -37,9 +37,14 @@ static inline double vpdsi_axis_far(double p, double lo, double hi, double P)
 {
     double a = fabs(p - lo), b = fabs(p - hi), best = a > b ? a : b;
     if (P > 0) {
-        double q;
-        for (q = p - P; q <= p + P; q += P) {
-            double qa = fabs(q - lo), qb = fabs(q - hi), f = qa > qb ? qa : qb;
+        double q[2], qa, qb, f;
+        int i;
+        q[0] = p - P;
+        q[1] = p + P;
+        for (i = 0; i < 2; i++) {
+            qa = fabs(q[i] - lo);
+            qb = fabs(q[i] - hi);
+            f = qa > qb ? qa : qb;
             if (f < best) best = f;
         }
     }

@@ -13,6 +13,72 @@
 #define UNCOVERED_DEPTH 40
 
 
+double vpdsi_coverage_reach(const vpds_sampler *s, double r_hi)
+{
+    double scale = s->run.t * s->coverage, sl = scale * s->sizing.lipschitz;
+    int uses_u = s->rule == VPDS_RULE_CURRENT || s->rule == VPDS_RULE_BIGGER;
+    if (!uses_u) return scale * r_hi;
+    return sl < 1 ? scale * r_hi / (1 - sl) : INFINITY;
+}
+
+vpds_status vpdsi_uncovered_index(vpds_sampler *s)
+{
+    const vpdsi_run *run = &s->run;
+    int d = s->dim, k;
+    size_t i, m = 0, nx;
+    uint64_t c[VPDS_MAX_DIM];
+    vpdsi_kd_samples v;
+    s->u_ready = 0;
+    for (i = 0; i < run->next.count; i++) m += s->next_u[i] != 0;
+    if (vpdsi_mul_size(m + 1, (size_t)d, &nx) ||
+        vpdsi_mem_reserve(&s->mem, (void **)&s->ux, &s->cap_ux, nx, sizeof(double)) ||
+        vpdsi_mem_reserve(&s->mem, (void **)&s->ur, &s->cap_ur, m + 1, sizeof(double)) ||
+        vpdsi_mem_reserve(&s->mem, (void **)&s->uf, &s->cap_uf, m + 1, 1)) {
+        vpdsi_set_error(s, "out of memory indexing %zu uncovered cells", m);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    vpdsi_kd_clear(&s->utree);
+    if (vpdsi_kd_reserve(&s->utree, &s->mem, m + 1, m + 1)) {
+        vpdsi_set_error(s, "out of memory indexing %zu uncovered cells", m);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    s->u_half = 0;
+    v.x = s->ux;
+    v.r = s->ur;
+    v.flags = s->uf;
+    for (i = 0, m = 0; i < run->next.count; i++) {
+        double half2 = 0;
+        if (!s->next_u[i]) continue;
+        vpdsi_cells_get(&run->next, i, d, c);
+        for (k = 0; k < d; k++) {
+            double side = ldexp(run->side0[k], -(int)run->next.level);
+            uint64_t last = (run->n0[k] << run->next.level) - 1;
+            double lo = s->lo[k] + (double)c[k] * side;
+            double hi = c[k] == last ? s->hi[k] : lo + side;
+            s->ux[m * (size_t)d + (size_t)k] = 0.5 * (lo + hi);
+            half2 += 0.25 * (hi - lo) * (hi - lo);
+        }
+        if (sqrt(half2) > s->u_half) s->u_half = sqrt(half2);
+        s->ur[m] = 1.0;
+        s->uf[m] = 0;
+        vpdsi_kd_insert(&s->utree, &v, (int32_t)m);
+        m++;
+    }
+    s->u_ready = 1;
+    return VPDS_OK;
+}
+
+double vpdsi_uncovered_nearest(const vpds_sampler *s, const double *p)
+{
+    vpdsi_kd_samples v;
+    int32_t arg;
+    if (!s->u_ready) return 0.0;
+    v.x = s->ux;
+    v.r = s->ur;
+    v.flags = s->uf;
+    return vpdsi_kd_min_ratio(&s->utree, &v, p, 0.0, 1.0, (int)VPDS_RULE_PRIOR, &arg);
+}
+
 vpds_status vpdsi_uncovered_in(vpds_sampler *s, const double *alo, const double *ahi,
                                double r_anchor, int *found)
 {
@@ -20,9 +86,8 @@ vpds_status vpdsi_uncovered_in(vpds_sampler *s, const double *alo, const double 
     unsigned children = 1u << d, b;
     double scale = s->run.t * s->coverage, L = s->sizing.lipschitz, sl = scale * L;
     int point = memcmp(alo, ahi, (size_t)d * sizeof(double)) == 0;
-    int uses_u = s->rule == VPDS_RULE_CURRENT || s->rule == VPDS_RULE_BIGGER;
     /* largest reach of the region: r(u) <= r_anchor + L |u - a| and |u - a| <= scale r(u) */
-    double reach = scale * (uses_u ? r_anchor / (1 - sl) : r_anchor);
+    double reach = vpdsi_coverage_reach(s, r_anchor);
     double centre[VPDS_MAX_DIM];
     size_t top = 0, boxes = 0, stride = 2 * (size_t)d + 1, need;
     vpdsi_kd_samples view;
@@ -72,6 +137,12 @@ vpds_status vpdsi_uncovered_in(vpds_sampler *s, const double *alo, const double 
             diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
         }
         if (gap2 > reach * reach) continue; /* misses the region */
+        if (s->u_ready) {
+            /* no cell that may hold an uncovered point meets the box */
+            double c2[VPDS_MAX_DIM];
+            for (k = 0; k < d; k++) c2[k] = 0.5 * (lo[k] + hi[k]);
+            if (vpdsi_uncovered_nearest(s, c2) > 0.5 * sqrt(diag2) + s->u_half) continue;
+        }
         if ((st = vpdsi_radius_at(s, p, &rp)) != VPDS_OK) return st;
         if (point) {
             double f = scale * vpdsi_rule_f(s->rule, r_anchor, rp), d2 = 0;

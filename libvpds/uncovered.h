@@ -15,4 +15,13 @@ struct vpds_sampler;
  * its box budget or precision (a dart then becomes a sample that may cover nothing new). */
 vpds_status vpdsi_uncovered_in(struct vpds_sampler *s, const double *alo, const double *ahi,
                                double r_anchor, int *found);
+/* Index the centres of the cells of run.next flagged in next_u (not inside one coverage disk):
+ * every uncovered point lies in one of them, now and after any later sample. */
+vpds_status vpdsi_uncovered_index(struct vpds_sampler *s);
+/* Distance from p to the nearest indexed centre (+INFINITY: none; 0 when no index is ready,
+ * which answers "maybe" to every question). */
+double vpdsi_uncovered_nearest(const struct vpds_sampler *s, const double *p);
+/* Upper bound of the distance at which a sample at a point of r <= r_hi covers (Table 1 reach:
+ * r(u) <= r_hi + L |u - a| for the rules that read r(u)). */
+double vpdsi_coverage_reach(const struct vpds_sampler *s, double r_hi);
 #endif
