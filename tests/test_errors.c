@@ -16,6 +16,7 @@ static vpds_status refused(const vpds_desc *d, const char *needle, vpds_status w
 }
 
 static double ramp(const double *x, void *u) { (void)u; return 0.001 + 0.3 * x[0]; }
+static double big(const double *x, void *u) { (void)x; (void)u; return 0.6; }
 static void *only_alloc(size_t n, void *u) { (void)u; return malloc(n); }
 static double steep(const double *x, void *u) { (void)u; return 0.01 + 0.4 * x[0]; }
 
@@ -67,8 +68,8 @@ int main(void)
         d.lo = l2; d.hi = h2;
         refused(&d, "overflows", VPDS_ERR_OVERFLOW);
     }
-    d = vpds_default_desc(); d.periodic = periodic;
-    refused(&d, "desc.periodic[1] = 1", VPDS_ERR_UNSUPPORTED);
+    d = vpds_default_desc(); d.periodic = periodic; d.radius = 0.5;
+    refused(&d, "desc.periodic[1]: the side 1 is not above 2 * coverage * radius = 1", VPDS_ERR_INVALID_ARGUMENT);
 
     /* radius, rule, radii factors */
     d = vpds_default_desc(); d.radius = 0; refused(&d, "desc.radius = 0", VPDS_ERR_INVALID_ARGUMENT);
@@ -79,7 +80,8 @@ int main(void)
     d = vpds_default_desc(); d.inhibition = 2; refused(&d, "desc.inhibition = 2 > desc.coverage = 1", VPDS_ERR_INVALID_ARGUMENT);
     d.inhibition = NAN; refused(&d, "desc.inhibition = nan", VPDS_ERR_INVALID_ARGUMENT);
     d = vpds_default_desc(); d.coverage = 0; refused(&d, "desc.coverage = 0", VPDS_ERR_INVALID_ARGUMENT);
-    d = vpds_default_desc(); d.inhibition = 0.5; refused(&d, "two radii", VPDS_ERR_UNSUPPORTED);
+    d = vpds_default_desc(); d.inhibition = 0.5;
+    CHECK(vpds_validate(&d, msg, sizeof msg) == VPDS_OK); /* two radii */
     d = vpds_default_desc(); d.weighted = 1; d.sizing = ramp; d.lipschitz = 0.3;
     refused(&d, "desc.weighted with a sizing callback needs desc.radius_min", VPDS_ERR_INVALID_ARGUMENT);
     /* weighted: a callback going below the declared radius_min is caught */
@@ -197,8 +199,33 @@ int main(void)
     CHECK(vpds_refine(s, 1.5) == VPDS_ERR_STATE && strstr(vpds_last_error(s), "t = 1.5"));
     {
         double x[2], t;
-        CHECK(vpds_next(s, 0, x, &t) == VPDS_ERR_UNSUPPORTED && strstr(vpds_last_error(s), "vpds_next"));
+        size_t n = vpds_count(s);
+        CHECK(vpds_next(s, 0, NULL, &t) == VPDS_ERR_INVALID_ARGUMENT && strstr(vpds_last_error(s), "x_out"));
+        CHECK(vpds_next(s, 0, x, NULL) == VPDS_ERR_INVALID_ARGUMENT);
+        CHECK(vpds_next(s, NAN, x, &t) == VPDS_ERR_INVALID_ARGUMENT && strstr(vpds_last_error(s), "NaN"));
+        CHECK(vpds_next(s, 1.0, x, &t) == VPDS_STREAM_END && vpds_count(s) == n); /* maximal at 1 */
+        CHECK(vpds_next(s, 0, x, &t) == VPDS_OK && t <= 1.0 && vpds_count(s) == n + 1);
+        CHECK(vpds_refine(s, t) == VPDS_OK);              /* already maximal at the stream's t */
+        CHECK(vpds_refine(s, t * 1.01) == VPDS_ERR_STATE); /* above the stream's scale */
     }
+    vpds_destroy(s);
+
+    /* a stream cannot start inside an unfinished run */
+    d = vpds_default_desc(); d.radius = 0.02; d.budget = 100;
+    CHECK(vpds_create(&d, &s) == VPDS_OK && vpds_run(s) == VPDS_PAUSED);
+    {
+        double x[2], t;
+        size_t n = vpds_count(s);
+        CHECK(vpds_next(s, 0, x, &t) == VPDS_ERR_STATE && strstr(vpds_last_error(s), "not finished"));
+        CHECK(vpds_count(s) == n);
+    }
+    vpds_destroy(s);
+
+    /* periodic: a sizing whose radius makes a disk meet its own image at the run's scale */
+    d = vpds_default_desc(); d.periodic = periodic; d.sizing = big; d.lipschitz = 0;
+    CHECK(vpds_create(&d, &s) == VPDS_OK);
+    CHECK(vpds_run(s) == VPDS_ERR_INVALID_ARGUMENT && strstr(vpds_last_error(s), "periodic axis 1"));
+    CHECK(vpds_count(s) == 0);
     vpds_destroy(s);
 
     /* refining while a run at another scale is paused */
