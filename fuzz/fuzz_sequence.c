@@ -10,7 +10,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     vpds_desc d = vpds_default_desc();
     double lo[VPDS_MAX_DIM] = {0}, hi[VPDS_MAX_DIM] = {1, 1, 1, 1, 1, 1, 1, 1};
     vpds_sampler *s = NULL;
-    int ops = 0, k;
+    int ops = 0, k, periodic[VPDS_MAX_DIM] = {0};
     d.dim = 1 + take_u8(&b) % 3;
     d.lo = lo;
     d.hi = hi;
@@ -21,7 +21,21 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         d.sizing = ramp_fn;
         d.lipschitz = 0.2;
     }
-    if (vpds_create(&d, &s) != VPDS_OK) abort();
+    {
+        /* two radii and periodic axes (the sizing depends on |x0|: not periodic along 0) */
+        uint8_t m = take_u8(&b);
+        if (m & 1) {
+            double v = take_double(&b, 0.3, 1.0, 1);
+            d.inhibition = v >= 0.3 && v <= 1.0 ? v : 0.5;
+        }
+        for (k = 0; k < d.dim; k++) periodic[k] = (m >> (1 + k)) & 1 && (k > 0 || !d.sizing);
+        d.periodic = periodic;
+    }
+    if (vpds_create(&d, &s) != VPDS_OK) {
+        char msg[256];
+        vpds_validate(&d, msg, sizeof msg);
+        FUZZ_ASSERT(0, "create refused: %s", msg);
+    }
     while (b.n && ops++ < 24) {
         vpds_status st = VPDS_OK;
         size_t count_before = vpds_count(s);
@@ -38,8 +52,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             st = vpds_refine(s, t);
             while (st == VPDS_PAUSED) st = vpds_run(s);
         } else if (op == 3) {
-            double x[VPDS_MAX_DIM], t;
-            st = vpds_next(s, 0, x, &t);
+            vpds_stats before = vpds_get_stats(s);
+            double x[VPDS_MAX_DIM], t, prev = before.maximal ? before.t : INFINITY;
+            int m = 1 + take_u8(&b) % 40;
+            while (m-- > 0 && (st = vpds_next(s, 0, x, &t)) == VPDS_OK) {
+                FUZZ_ASSERT(t <= prev, "stream t rose: %g after %g", t, prev);
+                prev = t;
+            }
         } else if (op == 4) {
             size_t n = take_u8(&b) % 4, i;
             double x[4 * VPDS_MAX_DIM], r[4];
@@ -61,7 +80,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
         check_status(st);
         if (st < 0) FUZZ_ASSERT(vpds_last_error(s)[0] != 0, "error %d without a message", (int)st);
-        if (vpds_count(s) != count_before) check_samples(s, lo, hi, d.rule, 1.0);
+        if (vpds_count(s) != count_before) check_samples_on(s, lo, hi, d.rule, d.inhibition, periodic);
     }
     vpds_destroy(s);
     return 0;
