@@ -64,8 +64,8 @@ def test_errors_exit_non_zero_with_the_c_message(tmp_path):
     assert res.returncode == 2 and "desc.radius = -1" in res.stderr
     res = vpds("sample", "--sizing", "0.01 + y", "--lipschitz", "0.1", check=False)
     assert res.returncode != 0 and "does not evaluate" in res.stderr
-    res = vpds("sample", "--stream", "10", check=False)
-    assert res.returncode == 2 and "not supported" in res.stderr
+    res = vpds("sample", "--radius", "0", check=False)
+    assert res.returncode == 2 and "desc.radius = 0" in res.stderr
     res = vpds("sample", "-o", str(tmp_path / "x.txt"), check=False)
     assert res.returncode != 0 and ".npy, .npz, .csv or .ply" in res.stderr
 

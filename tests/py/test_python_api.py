@@ -102,8 +102,8 @@ def test_errors_carry_the_c_message():
         vpds.PoissonDisk(2, sizing=RAMP)
     with pytest.raises(vpds.VpdsValueError, match="limit 0.5"):
         vpds.PoissonDisk(2, sizing=RAMP, lipschitz=0.5, rule="prior")
-    with pytest.raises(NotImplementedError, match="two radii"):
-        vpds.PoissonDisk(2, inhibition=0.5, coverage=1.0)
+    with pytest.raises(vpds.VpdsValueError, match="need R_f <= R_c"):
+        vpds.PoissonDisk(2, inhibition=2.0, coverage=1.0)
     with pytest.raises(ValueError, match="rule"):
         vpds.PoissonDisk(2, rule="largest")
     with pytest.raises(vpds.VpdsValueError, match="desc.dim = 9"):
