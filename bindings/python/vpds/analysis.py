@@ -7,13 +7,21 @@ so it is an independent check of its output (the project's tests use it, and `vp
         g(y) = min_i |y - x_i| - s f(x_i, y),
     which is (1 + s L)-Lipschitz, so a box whose centre has g(c) + K h/2 <= 0 is covered whole
     and a centre with g(c) > 0 is a gap: no gap wider than the stopping size can be missed,
-  - the Delaunay bounds of Table 1 on triangles whose circumcentre lies in the box (2D).
+  - the Delaunay bounds of Table 1 on triangles whose circumcentre lies in the box (2D),
+    and those of Prop. 4.1-4.2 for two radii (R_f = t inhibition r <= R_c = t coverage r),
+  - periodic boxes: every check takes `periodic` (one flag per axis) and then measures the
+    toroidal (minimum-image) distance, by tiling the samples into their 3^p images; and a 3^p
+    tiled copy of a periodic output must itself be a valid sampling across the seams,
+  - the continuous stream's prefix property (Section 4.2): each prefix {k : t_k >= tau} is
+    conflict-free and maximal at tau,
+  - for a uniform radius, the exact largest empty ball of the box (Delaunay circumcentres),
+    which is what farthest-point insertion must pick.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Callable, Optional
+from typing import Callable, Optional, Sequence
 
 import numpy as np
 from scipy.spatial import Delaunay, cKDTree
@@ -64,25 +72,171 @@ def load(path: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return x, r, t
 
 
+Periodic = Optional[Sequence[bool]]
+
+
+def _periodic_mask(periodic: Periodic, d: int) -> Optional[np.ndarray]:
+    """The periodic flags as a bool array, or None when no axis is periodic."""
+    if periodic is None:
+        return None
+    m = np.asarray(periodic, dtype=bool).reshape(-1)
+    if m.shape != (d,):
+        raise ValueError(f"periodic has {m.size} flags for {d} axes")
+    return m if m.any() else None
+
+
+def wrap_points(x: np.ndarray, lo: np.ndarray, hi: np.ndarray, periodic: Periodic) -> np.ndarray:
+    """Points moved into [lo, hi) along the periodic axes: one representative per torus point,
+    so that the 3^p images below hold the minimum image of every pair."""
+    x = np.array(x, dtype=np.float64, copy=True)
+    mask = _periodic_mask(periodic, x.shape[1])
+    if mask is None:
+        return x
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    ext = hi - lo
+    x[:, mask] = lo[mask] + np.mod(x[:, mask] - lo[mask], ext[mask])
+    return x
+
+
+def toroidal_distance(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                      periodic: Periodic) -> np.ndarray:
+    """|a - b| with the minimum image along the periodic axes (rows broadcast)."""
+    a, b = np.atleast_2d(a).astype(np.float64), np.atleast_2d(b).astype(np.float64)
+    diff = np.abs(a - b)
+    mask = _periodic_mask(periodic, diff.shape[1])
+    if mask is not None:
+        ext = (np.asarray(hi, dtype=np.float64) - np.asarray(lo, dtype=np.float64))[mask]
+        dm = np.mod(diff[:, mask], ext)
+        diff[:, mask] = np.minimum(dm, ext - dm)
+    return np.sqrt((diff ** 2).sum(axis=1))
+
+
+def periodic_images(x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                    periodic: Periodic, margin: Optional[float] = None
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(points, radii, source index) of the 3^p copies of the wrapped points shifted by -1, 0, +1
+    periods along the p periodic axes, the unshifted copy first (rows 0..n-1 are the wrapped
+    samples themselves). Why: for points of the box the minimum image of any sample is among
+    them, so Euclidean checks on the copies are toroidal checks. With `margin`, only copies
+    within that distance of the box are kept (the unshifted copy always is)."""
+    x = np.asarray(x, dtype=np.float64)
+    r = np.asarray(r, dtype=np.float64)
+    d = x.shape[1]
+    mask = _periodic_mask(periodic, d)
+    n = len(x)
+    if mask is None:
+        return x.copy(), r.copy(), np.arange(n)
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    ext = hi - lo
+    xw = wrap_points(x, lo, hi, mask)
+    axes = np.flatnonzero(mask)
+    shifts = np.array(np.meshgrid(*[[0, -1, 1]] * len(axes), indexing="ij"))
+    shifts = shifts.reshape(len(axes), -1).T
+    pts, rad, src = [], [], []
+    for sh in shifts:
+        off = np.zeros(d)
+        off[axes] = sh * ext[axes]
+        y = xw + off
+        keep = np.ones(n, bool)
+        if margin is not None and sh.any():
+            below = np.maximum(lo - y, 0.0)
+            above = np.maximum(y - hi, 0.0)
+            keep = np.sqrt(((below + above) ** 2).sum(axis=1)) <= margin
+        pts.append(y[keep])
+        rad.append(r[keep])
+        src.append(np.flatnonzero(keep))
+    return np.concatenate(pts), np.concatenate(rad), np.concatenate(src)
+
+
+def _wrapped_sizing(sizing: "Sizing", lo: np.ndarray, hi: np.ndarray, mask: np.ndarray) -> "Sizing":
+    """The sizing read at the wrapped point: r of a periodic image is r of the sample."""
+    return Sizing(lambda y: sizing.fn(wrap_points(y, lo, hi, mask)), sizing.lipschitz)
+
+
 def empty_disk_violations(x: np.ndarray, r: np.ndarray, rule: str, scale: float, lipschitz: float,
-                          rel_tol: float = 1e-12) -> int:
-    """Pairs j < i with |x_i - x_j| < scale f(x_j, x_i) (x_j the earlier sample)."""
+                          rel_tol: float = 1e-12, *, periodic: Periodic = None,
+                          lo: Optional[np.ndarray] = None, hi: Optional[np.ndarray] = None) -> int:
+    """Pairs j < i with |x_i - x_j| < scale f(x_j, x_i) (x_j the earlier sample); with
+    `periodic` (and the box lo, hi) the distance is the toroidal one."""
+    scales = np.full(len(x), float(scale))
+    return len(_conflict_pairs(x, r, scales, rule, lipschitz, rel_tol, periodic, lo, hi)[0])
+
+
+def conflicts_at_insertion_scales(x: np.ndarray, r: np.ndarray, t: np.ndarray, rule: str,
+                                  inhibition: float, lipschitz: float, rel_tol: float = 0.0, *,
+                                  periodic: Periodic = None, lo: Optional[np.ndarray] = None,
+                                  hi: Optional[np.ndarray] = None) -> int:
+    """Pairs j < i with |x_i - x_j| < t_i inhibition (1 - rel_tol) f(x_j, x_i).
+
+    Why: a pair j < i belongs to every prefix {k : t_k >= tau} with tau <= t_i (t non-increasing),
+    and conflicts most at the largest such tau, t_i; so this one pass checks the empty-disk half
+    of the prefix property at every tau at once. Samples with t_i = inf (fixed points) are not
+    checked against earlier samples (fixed points are not checked against each other)."""
+    t = np.asarray(t, dtype=np.float64)
+    scales = np.where(np.isfinite(t), t * inhibition * (1 - rel_tol), 0.0)
+    return len(_conflict_pairs(x, r, scales, rule, lipschitz, 1e-12, periodic, lo, hi)[0])
+
+
+def _conflict_pairs(x: np.ndarray, r: np.ndarray, scales: np.ndarray, rule: str, lipschitz: float,
+                    rel_tol: float, periodic: Periodic, lo: Optional[np.ndarray],
+                    hi: Optional[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """(i, j), j < i, with |x_i - x_j| < scales[i] f(x_j, x_i) (1 - rel_tol), each pair once.
+
+    Samples are processed in blocks of doubling size, each against a tree of the samples (or
+    their periodic images) before the block's end: the early samples of a stream have scales
+    far above the final one, and must not each drag the whole set out of one tree."""
+    x = np.asarray(x, dtype=np.float64)
+    r = np.asarray(r, dtype=np.float64)
     n = len(x)
     if n < 2:
-        return 0
-    tree = cKDTree(x)
-    sl = scale * lipschitz
-    # every conflicting earlier sample lies within scale r_i / (1 - sL) of x_i (Lipschitz)
-    reach = scale * r / (1 - sl) if rule in ("prior", "bigger") else scale * r
-    lists = tree.query_ball_point(x, reach * (1 + 1e-9), return_sorted=False)
-    counts = np.fromiter((len(v) for v in lists), dtype=np.int64, count=n)
-    i = np.repeat(np.arange(n), counts)
-    j = np.fromiter((k for v in lists for k in v), dtype=np.int64, count=int(counts.sum()))
-    keep = j < i
-    i, j = i[keep], j[keep]
-    dist = np.linalg.norm(x[i] - x[j], axis=1)
-    f = scale * rule_f(rule, r[j], r[i])
-    return int(np.count_nonzero(dist < f * (1 - rel_tol)))
+        return np.empty(0, np.int64), np.empty(0, np.int64)
+    mask = _periodic_mask(periodic, x.shape[1])
+    if mask is not None:
+        if lo is None or hi is None:
+            raise ValueError("periodic checks need the box: pass lo and hi")
+        lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+        x = wrap_points(x, lo, hi, mask)
+    # every conflicting earlier sample lies within s r_i / (1 - s L) of x_i (Lipschitz; prior and
+    # bigger), within s r_i (current, smaller), and always within s r_max and the set's diameter
+    ext = x.max(axis=0) - x.min(axis=0)
+    if mask is not None:
+        ext = np.maximum(ext, hi - lo)
+    diam = float(np.linalg.norm(ext)) * (1 + 1e-9) + 1e-300
+    sl = scales * lipschitz
+    if rule in ("prior", "bigger"):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            reach = np.where(sl < 1, scales * r / np.maximum(1 - sl, 1e-300), np.inf)
+    else:
+        reach = scales * r
+    reach = np.minimum(np.minimum(reach, scales * float(r.max())), diam) * (1 + 1e-9)
+    out_i, out_j = [], []
+    a = 0
+    while a < n:
+        b = min(n, max(1, 2 * a))
+        if mask is None:
+            pts, src = x[:b], np.arange(b)
+        else:
+            pts, _, src = periodic_images(x[:b], r[:b], lo, hi, mask,
+                                          margin=float(reach[a:b].max()))
+        tree = cKDTree(pts)
+        lists = tree.query_ball_point(x[a:b], reach[a:b], return_sorted=False)
+        counts = np.fromiter((len(v) for v in lists), dtype=np.int64, count=b - a)
+        i = np.repeat(np.arange(a, b), counts)
+        k = np.fromiter((m for v in lists for m in v), dtype=np.int64, count=int(counts.sum()))
+        j = src[k]
+        keep = j < i
+        i, j, k = i[keep], j[keep], k[keep]
+        dist = np.linalg.norm(x[i] - pts[k], axis=1)
+        f = scales[i] * rule_f(rule, r[j], r[i])
+        bad = dist < f * (1 - rel_tol)
+        out_i.append(i[bad])
+        out_j.append(j[bad])
+        a = b
+    i, j = np.concatenate(out_i), np.concatenate(out_j)
+    if len(i):
+        key = np.unique(i * n + j)  # one pair, however many of its images conflict
+        i, j = key // n, key % n
+    return i, j
 
 
 def coverage_margin(points: np.ndarray, tree: cKDTree, x: np.ndarray, r: np.ndarray, rule: str,
@@ -94,15 +248,17 @@ def coverage_margin(points: np.ndarray, tree: cKDTree, x: np.ndarray, r: np.ndar
         dist, idx = dist[:, None], idx[:, None]
     g = (dist - scale * rule_f(rule, r[idx], r_at[:, None])).min(axis=1)
     if exact:
-        rmax = r.max()
-        for m in range(len(points)):
-            reach = g[m] + scale * max(rmax, r_at[m])
-            if reach <= 0:
-                continue
-            near = tree.query_ball_point(points[m], reach * (1 + 1e-9))
-            if near:
-                nd = np.linalg.norm(x[near] - points[m], axis=1)
-                g[m] = min(g[m], float((nd - scale * rule_f(rule, r[near], r_at[m])).min()))
+        # every sample that can lower g lies within g + scale max(r) of the point
+        reach = g + scale * np.maximum(r.max(), r_at)
+        m = np.flatnonzero(reach > 0)
+        if len(m):
+            lists = tree.query_ball_point(points[m], reach[m] * (1 + 1e-9), return_sorted=False)
+            counts = np.fromiter((len(v) for v in lists), dtype=np.int64, count=len(m))
+            rows = np.repeat(m, counts)
+            cols = np.fromiter((c for v in lists for c in v), dtype=np.int64,
+                               count=int(counts.sum()))
+            nd = np.linalg.norm(x[cols] - points[rows], axis=1)
+            np.minimum.at(g, rows, nd - scale * rule_f(rule, r[cols], r_at[rows]))
     return g
 
 
@@ -131,7 +287,15 @@ class MaximalityReport:
 
 def check_maximal(x: np.ndarray, r: np.ndarray, rule: str, scale: float, sizing: Sizing,
                   lo: np.ndarray, hi: np.ndarray, rel_tol: float = 1e-9, probes: int = 200_000,
-                  seed: int = 0, max_boxes: int = 20_000_000) -> MaximalityReport:
+                  seed: int = 0, max_boxes: int = 20_000_000, *,
+                  periodic: Periodic = None, stop_at_gap: bool = False) -> MaximalityReport:
+    """Every point of the box within scale f of a sample (branch-and-bound, then probes); with
+    `periodic`, of a sample's periodic image (the torus is covered iff the box is, by images).
+    With stop_at_gap, the search ends at the first level that finds a gap (a verdict without
+    resolving the gap's whole boundary, which costs boxes in proportion to its length)."""
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    if _periodic_mask(periodic, x.shape[1]) is not None:
+        x, r, _ = periodic_images(x, r, lo, hi, periodic)
     d = x.shape[1]
     tree = cKDTree(x)
     K = 1.0 + (0.0 if rule == "prior" else scale * sizing.lipschitz)
@@ -162,6 +326,8 @@ def check_maximal(x: np.ndarray, r: np.ndarray, rule: str, scale: float, sizing:
             if real.any():
                 gaps += int(real.sum())
                 worst = centres[suspicious][np.argmax(ge)]
+                if stop_at_gap:
+                    break
         open_ = (g + K * half_diag > 0) & ~(g > rel_tol * r_c)
         if open_.any():
             # tighter: one sample covering the whole box (its farthest corner within reach)
@@ -210,9 +376,10 @@ def table1_bounds(rule: str, L: float) -> tuple[float, float, float]:
     return 1 / (1 + L), 2 / (1 - L), (1 - L) / 2
 
 
-def _interior_triangles(x: np.ndarray, lo: np.ndarray, hi: np.ndarray):
-    """Delaunay triangles whose circumcentre lies in the box (where maximality bounds them):
-    vertex indices, edge lengths opposite each vertex, circumcentres, circumradii, angles."""
+def _interior_triangles(x: np.ndarray, lo: np.ndarray, hi: np.ndarray, disk_inside: bool = False):
+    """Delaunay triangles whose circumcentre lies in the box (where maximality bounds them), or
+    with `disk_inside` whose whole circumdisk does: vertex indices, edge lengths opposite each
+    vertex, circumcentres, circumradii, angles."""
     tri = Delaunay(x)
     s = tri.simplices
     a, b, c = x[s[:, 0]], x[s[:, 1]], x[s[:, 2]]
@@ -221,6 +388,9 @@ def _interior_triangles(x: np.ndarray, lo: np.ndarray, hi: np.ndarray):
     uy = ((a ** 2).sum(1) * (c[:, 0] - b[:, 0]) + (b ** 2).sum(1) * (a[:, 0] - c[:, 0]) + (c ** 2).sum(1) * (b[:, 0] - a[:, 0])) / d
     u = np.stack([ux, uy], axis=1)
     inside = np.all((u >= lo) & (u <= hi), axis=1) & np.isfinite(u).all(axis=1)
+    if disk_inside:
+        rad = np.linalg.norm(a - u, axis=1)[:, None]
+        inside &= np.all((u - rad >= lo) & (u + rad <= hi), axis=1)
     s, a, b, c, u = s[inside], a[inside], b[inside], c[inside], u[inside]
     la = np.linalg.norm(b - c, axis=1)
     lb = np.linalg.norm(c - a, axis=1)
@@ -295,3 +465,304 @@ def delaunay_histograms(x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np.nda
     s, lengths, _, _, angles = _interior_triangles(x, lo, hi)
     min_angles = np.degrees(np.minimum(np.minimum(*angles[:2]), angles[2]))
     return min_angles, _edge_ratios(s, lengths, r)
+
+
+# -- two radii: Prop. 4.1-4.2 ---------------------------------------------------------------------
+
+
+@dataclass
+class TwoRadiiDelaunayReport:
+    """Prop. 4.1-4.2 at scale t for a uniform r: R_f = t inhibition r, R_c = t coverage r."""
+
+    triangles: int
+    min_angle_deg: float
+    angle_bound_deg: float     # arcsin(R_f / (2 R_c))
+    edge_min: float
+    edge_min_bound: float      # R_f
+    edge_max: float
+    edge_max_bound: float      # 2 R_c
+    circumradius_max: float
+    circumradius_bound: float  # R_c
+
+    def violations(self, rel_tol: float = 1e-12) -> list[str]:
+        """The bounds broken (empty when all hold), with round-off allowance rel_tol."""
+        out = []
+        if self.edge_min < self.edge_min_bound * (1 - rel_tol):
+            out.append(f"edge {self.edge_min} < R_f = {self.edge_min_bound}")
+        if self.edge_max > self.edge_max_bound * (1 + rel_tol):
+            out.append(f"edge {self.edge_max} > 2 R_c = {self.edge_max_bound}")
+        if self.circumradius_max > self.circumradius_bound * (1 + rel_tol):
+            out.append(f"circumradius {self.circumradius_max} > R_c = {self.circumradius_bound}")
+        if self.min_angle_deg < self.angle_bound_deg * (1 - rel_tol) - 1e-9:
+            out.append(f"angle {self.min_angle_deg} deg < {self.angle_bound_deg} deg")
+        return out
+
+
+def check_delaunay_two_radii(x: np.ndarray, radius: float, t: float, inhibition: float,
+                             coverage: float, lo: np.ndarray, hi: np.ndarray,
+                             disk_inside: bool = True) -> TwoRadiiDelaunayReport:
+    """Prop. 4.1 (|e| in [R_f, 2R], R <= R_c) and Prop. 4.2 (sin a >= |e| / 2R, so the smallest
+    angle is at least arcsin(R_f / 2R_c): 30 deg for equal radii, 14.48 deg for R_c = 2 R_f)
+    on the interior Delaunay triangles (2D): those whose circumdisk lies in the box (or, with
+    disk_inside False, whose circumcentre does), where the empty circumdisk is an uncovered
+    region of the domain that maximality bounds."""
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    s, (la, lb, lc), _, R, angles = _interior_triangles(np.asarray(x, dtype=np.float64), lo, hi,
+                                                        disk_inside)
+    r_f, r_c = t * inhibition * radius, t * coverage * radius
+    if len(s) == 0:
+        return TwoRadiiDelaunayReport(0, 180.0, math.degrees(math.asin(min(1.0, r_f / (2 * r_c)))),
+                                      math.inf, r_f, 0.0, 2 * r_c, 0.0, r_c)
+    edges = np.concatenate([la, lb, lc])
+    min_angle = float(np.degrees(np.minimum(np.minimum(*angles[:2]), angles[2]).min()))
+    return TwoRadiiDelaunayReport(int(len(s)), min_angle,
+                                  math.degrees(math.asin(min(1.0, r_f / (2 * r_c)))),
+                                  float(edges.min()), r_f, float(edges.max()), 2 * r_c,
+                                  float(R.max()), r_c)
+
+
+# -- periodic: the tiled copy ---------------------------------------------------------------------
+
+
+@dataclass
+class TilingReport:
+    copies: int                    # 3^p
+    points: int                    # samples in the tiled copy
+    conflicts: int                 # pairs of the tiled copy (any two copies) closer than allowed
+    maximality: MaximalityReport   # over a tile-sized window of the tiled copy, seams inside
+
+
+def _symmetric_f(rule: str, ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
+    """f for a pair without an order: conflicting in both orders (prior, current: the smaller r)."""
+    return np.maximum(ra, rb) if rule == "bigger" else np.minimum(ra, rb)
+
+
+def check_tiling(x: np.ndarray, r: np.ndarray, rule: str, sizing: Sizing, lo: np.ndarray,
+                 hi: np.ndarray, periodic: Periodic, conflict_scale: float, cover_scale: float,
+                 shift: float = 0.5, rel_tol: float = 1e-12, probes: int = 50_000,
+                 stop_at_gap: bool = False) -> TilingReport:
+    """A 3^p tiled copy of a periodic output is itself a valid sampling: no two of its points
+    (copies of one sample included) closer than conflict_scale f, with f for both orders of the
+    pair (bigger: max r, the other rules: min r), and maximal at cover_scale over the central
+    tile moved by `shift` periods along the periodic axes, so that the seams cross the window
+    (shift 0: the central tile itself). Why: it checks the seams with plain Euclidean geometry,
+    independently of the minimum-image bookkeeping of the periodic checks."""
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    mask = _periodic_mask(periodic, x.shape[1])
+    if mask is None:
+        raise ValueError("check_tiling needs at least one periodic axis")
+    xt, rt, _ = periodic_images(x, r, lo, hi, mask)
+    tree = cKDTree(xt)
+    pairs = tree.query_pairs(conflict_scale * float(rt.max()) * (1 + 1e-9), output_type="ndarray")
+    conflicts = 0
+    if len(pairs):
+        a, b = pairs[:, 0], pairs[:, 1]
+        dist = np.linalg.norm(xt[a] - xt[b], axis=1)
+        f = conflict_scale * _symmetric_f(rule, rt[a], rt[b])
+        conflicts = int(np.count_nonzero(dist < f * (1 - rel_tol)))
+    off = np.where(mask, shift * (hi - lo), 0.0)
+    rep = check_maximal(xt, rt, rule, cover_scale, _wrapped_sizing(sizing, lo, hi, mask),
+                        lo + off, hi + off, probes=probes, stop_at_gap=stop_at_gap)
+    return TilingReport(3 ** int(mask.sum()), len(xt), conflicts, rep)
+
+
+# -- the continuous stream: prefixes --------------------------------------------------------------
+
+
+def probe_coverage(x: np.ndarray, r: np.ndarray, rule: str, scale: float, sizing: Sizing,
+                   lo: np.ndarray, hi: np.ndarray, probes: int = 20_000, seed: int = 0, *,
+                   periodic: Periodic = None) -> tuple[int, float, Optional[np.ndarray]]:
+    """(gaps, max g / r, worst probe) over random probes of the box (and its corners): the cheap,
+    incomplete maximality check, for when the branch-and-bound would cost too much."""
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    d = len(lo)
+    if len(x) == 0:
+        return probes, math.inf, (lo + hi) / 2
+    if _periodic_mask(periodic, d) is not None:
+        x, r, _ = periodic_images(x, r, lo, hi, periodic)
+    rng = np.random.default_rng(seed)
+    corners = lo + np.array(np.meshgrid(*[[0, 1]] * d, indexing="ij")).reshape(d, -1).T * (hi - lo)
+    y = np.vstack([lo + rng.random((probes, d)) * (hi - lo), corners])
+    ry = sizing.fn(y)
+    tree = cKDTree(x)
+    g = coverage_margin(y, tree, x, r, rule, scale, ry)
+    sus = g > 1e-9 * ry
+    if sus.any():
+        g[sus] = coverage_margin(y[sus], tree, x, r, rule, scale, ry[sus], exact=True)
+    rel = g / ry
+    gaps = int(np.count_nonzero(rel > 1e-9))
+    w = int(np.argmax(rel))
+    return gaps, float(rel[w]), (y[w] if gaps else None)
+
+
+@dataclass
+class PrefixTauReport:
+    tau: float
+    size: int                  # samples with t_k >= tau
+    conflicts: int             # insertion-order pairs closer than tau inhibition (1 - rel_tol) f
+    gaps: int                  # uncovered points found at tau coverage f
+    worst: float               # max g / r found (g > 0: uncovered); B&B: its unresolved bound too
+    worst_gap: Optional[np.ndarray]
+    exhaustive: bool           # branch-and-bound (True) or random probes (False)
+    maximality_checked: bool   # False for tau below the last t (the record ends before tau)
+
+
+@dataclass
+class PrefixReport:
+    nonincreasing: bool
+    first_increase: int        # index k with t_k > t_{k-1}, or -1
+    conflicts_at_insertion: int  # pairs closer than t_i inhibition (1 - rel_tol) f: all taus
+    taus: list
+
+    @property
+    def ok(self) -> bool:
+        return (self.nonincreasing and self.conflicts_at_insertion == 0 and
+                all(p.conflicts == 0 and p.gaps == 0 for p in self.taus))
+
+    def failures(self) -> list:
+        return [p for p in self.taus if p.conflicts or p.gaps]
+
+
+def check_prefixes(x: np.ndarray, r: np.ndarray, t: np.ndarray, rule: str, inhibition: float,
+                   coverage: float, sizing: Sizing, lo: np.ndarray, hi: np.ndarray,
+                   taus: Sequence[float], rel_tol: float, periodic: Periodic = None, *,
+                   bnb_taus: Sequence[float] = (), probes: int = 20_000, seed: int = 0,
+                   bnb_rel_tol: float = 1e-9) -> PrefixReport:
+    """The stream's prefix property (Section 4.2): t is non-increasing, and for each tau the
+    prefix {k : t_k >= tau} is conflict-free at tau inhibition (1 - rel_tol) in insertion order
+    and maximal (covered) at tau coverage.
+
+    Conflicts: every pair is checked once at the scale of its later sample
+    (conflicts_at_insertion, all taus at once); a pair conflicting at some tau conflicts there
+    too, so the count at each of `taus` is taken from those pairs, and at each of `bnb_taus`
+    it is counted afresh on the prefix (a cross-check). Maximality: random probes at `taus`,
+    the branch-and-bound at `bnb_taus` (exhaustive, slower). The hardest tau for the prefix of
+    the first k samples is just above t_k, e.g. np.nextafter(t[k], inf). A tau below the last
+    t only gets the conflict check: the prefix there holds samples the record does not have."""
+    x = np.asarray(x, dtype=np.float64)
+    r = np.asarray(r, dtype=np.float64)
+    t = np.asarray(t, dtype=np.float64)
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    inc = np.flatnonzero(t[1:] > t[:-1])
+    first_increase = int(inc[0] + 1) if len(inc) else -1
+    scales = np.where(np.isfinite(t), t * inhibition * (1 - rel_tol), 0.0)
+    pi, pj = _conflict_pairs(x, r, scales, rule, sizing.lipschitz, 1e-12, periodic, lo, hi)
+    pdist = toroidal_distance(x[pi], x[pj], lo, hi, periodic) if len(pi) else np.empty(0)
+    pf = rule_f(rule, r[pj], r[pi]) if len(pi) else np.empty(0)
+    t_last = float(t[-1]) if len(t) else math.inf
+    reports = []
+    for m, (tau, exhaustive) in enumerate([(float(v), False) for v in taus] +
+                                          [(float(v), True) for v in bnb_taus]):
+        sel = t >= tau
+        xs, rs = x[sel], r[sel]
+        s_f = tau * inhibition * (1 - rel_tol)
+        if exhaustive:
+            conflicts = empty_disk_violations(xs, rs, rule, s_f, sizing.lipschitz,
+                                              periodic=periodic, lo=lo, hi=hi)
+        else:
+            conflicts = int(np.count_nonzero((t[pi] >= tau) & (t[pj] >= tau) &
+                                             (pdist < s_f * pf * (1 - 1e-12))))
+        gaps, worst, where, checked = 0, -math.inf, None, tau >= t_last and bool(sel.any())
+        if checked and exhaustive:
+            rep = check_maximal(xs, rs, rule, tau * coverage, sizing, lo, hi, rel_tol=bnb_rel_tol,
+                                probes=probes, seed=seed + m, periodic=periodic, stop_at_gap=True)
+            gaps, where = rep.gaps, rep.worst_gap
+            worst = rep.probes_max_rel
+            if rep.unresolved_bound > 0:
+                worst = max(worst, rep.unresolved_bound)
+            if where is not None:  # how deep the worst gap the search met is
+                worst = max(worst, _margin_at(where, xs, rs, rule, tau * coverage, sizing, lo, hi,
+                                              periodic))
+        elif checked:
+            gaps, worst, where = probe_coverage(xs, rs, rule, tau * coverage, sizing, lo, hi,
+                                                probes, seed + m, periodic=periodic)
+        reports.append(PrefixTauReport(tau, int(sel.sum()), conflicts, gaps, worst, where,
+                                       exhaustive, checked))
+    return PrefixReport(first_increase < 0, first_increase, len(pi), reports)
+
+
+def _margin_at(y: np.ndarray, x: np.ndarray, r: np.ndarray, rule: str, scale: float,
+               sizing: Sizing, lo: np.ndarray, hi: np.ndarray, periodic: Periodic) -> float:
+    """g(y) / r(y) exactly, at one point of the box."""
+    if _periodic_mask(periodic, x.shape[1]) is not None:
+        x, r, _ = periodic_images(x, r, lo, hi, periodic)
+    y = np.asarray(y, dtype=np.float64)[None, :]
+    ry = sizing.fn(y)
+    g = coverage_margin(y, cKDTree(x), x, r, rule, scale, ry, exact=True)
+    return float(g[0] / ry[0])
+
+
+# -- uniform radius: the exact farthest point -----------------------------------------------------
+
+
+def _circumcentres(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Circumcentres of simplices p (m, d+1, d) and a mask of the non-degenerate ones."""
+    a = 2 * (p[:, 1:, :] - p[:, :1, :])
+    b = (p[:, 1:, :] ** 2).sum(axis=2) - (p[:, :1, :] ** 2).sum(axis=2)
+    scale = np.abs(a).max(axis=(1, 2)) ** a.shape[1]
+    det = np.linalg.det(a)
+    ok = np.abs(det) > 1e-12 * np.maximum(scale, 1e-300)
+    c = np.full((len(p), p.shape[2]), np.nan)
+    if ok.any():
+        c[ok] = np.linalg.solve(a[ok], b[ok][..., None])[..., 0]
+    return c, ok
+
+
+def largest_empty_ball(x: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+                       periodic: Periodic = None) -> tuple[np.ndarray, float]:
+    """(y, R): the point of the box farthest from the samples x and its distance (toroidal along
+    periodic axes), exact up to round-off, in 2D and 3D (any d scipy's Delaunay takes).
+    Samples may lie outside the box.
+
+    Why: with a uniform radius and inhibition = coverage the stream is farthest-point insertion,
+    and a set is maximal at scale t iff R <= t coverage r. The maximum of the distance to the
+    nearest sample over a box is at a Voronoi vertex in the box, where a Voronoi face meets the
+    box's boundary, or at a corner; mirroring the samples across each non-periodic face (and
+    taking periodic images) makes all of them circumcentres of Delaunay simplices, or corners.
+    Only samples within an upper bound of R of a face are mirrored (and imaged): those farther
+    cannot define a ball of radius R touching the face."""
+    x = np.asarray(x, dtype=np.float64)
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    d = len(lo)
+    mask = _periodic_mask(periodic, d)
+    pmask = np.zeros(d, bool) if mask is None else mask
+    if len(x) == 0:
+        return (lo + hi) / 2, math.inf
+    corners = lo + np.array(np.meshgrid(*[[0, 1]] * d, indexing="ij")).reshape(d, -1).T * (hi - lo)
+    # an upper bound U of R from a grid: every point is within half a cell diagonal of a node
+    m = int(np.clip(np.ceil((8 * len(x)) ** (1 / d)), 4, 400))
+    axes = [np.linspace(lo[k], hi[k], m) for k in range(d)]
+    nodes = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, d)
+    imgs, _, _ = periodic_images(x, np.zeros(len(x)), lo, hi, pmask if mask is not None else None)
+    tree = cKDTree(imgs)
+    U = float(tree.query(nodes)[0].max()) + 0.5 * float(np.linalg.norm((hi - lo) / (m - 1)))
+    U *= 1 + 1e-9
+    if mask is not None:
+        imgs, _, _ = periodic_images(x, np.zeros(len(x)), lo, hi, mask, margin=2 * U)
+        tree = cKDTree(imgs)
+    aug = [imgs]
+    for k in np.flatnonzero(~pmask):
+        for face, side in ((lo[k], 1.0), (hi[k], -1.0)):
+            # a sample beyond the face (a fixed point) is not mirrored: its mirror would be a
+            # false, nearer sample inside the box
+            gap = side * (imgs[:, k] - face)
+            near = (gap >= 0) & (gap <= U)
+            mir = imgs[near].copy()
+            mir[:, k] = 2 * face - mir[:, k]
+            aug.append(mir)
+    aug = np.concatenate(aug)
+    cand = [corners]
+    if len(aug) >= d + 1:
+        try:
+            tri = Delaunay(aug)
+            c, ok = _circumcentres(aug[tri.simplices])
+            c = c[ok]
+            tol = 1e-12 * float(np.abs(hi - lo).max())
+            c = c[np.all((c >= lo - tol) & (c <= hi + tol), axis=1)]
+            cand.append(np.clip(c, lo, hi))
+        except Exception:  # noqa: BLE001 - too few or degenerate points: the grid and corners
+            cand.append(nodes)
+    cand = np.concatenate(cand)
+    dist = tree.query(cand)[0]
+    w = int(np.argmax(dist))
+    return cand[w], float(dist[w])
