@@ -142,10 +142,8 @@ static void cell_coords(const vpds_sampler *s, uint64_t idx, uint64_t *c)
     }
 }
 
-/* Box of the cell at `level` with integer coordinates c; the last cell of an axis ends exactly
- * at the box's face. Returns the squared diagonal. */
-static double cell_box(const vpds_sampler *s, unsigned level, const uint64_t *c, double *lo,
-                       double *hi)
+double vpdsi_cell_box(const vpds_sampler *s, unsigned level, const uint64_t *c, double *lo,
+                      double *hi)
 {
     const vpdsi_run *run = &s->run;
     double diag2 = 0;
@@ -178,7 +176,7 @@ static void draw_darts(const vpds_sampler *s, vpdsi_rng *rng, size_t n, double *
     int k, d = s->dim;
     for (j = 0; j < n; j++) {
         cell_coords(s, vpdsi_rng_below(rng, total), c);
-        cell_box(s, level, c, lo, hi);
+        vpdsi_cell_box(s, level, c, lo, hi);
         for (k = 0; k < d; k++) {
             double v = lo[k] + vpdsi_rng_unit(rng) * (hi[k] - lo[k]);
             out[j * (size_t)d + (size_t)k] = v > hi[k] ? hi[k] : v;
@@ -343,9 +341,9 @@ static void children_covered(const vpds_sampler *s, unsigned level, const uint64
     uint64_t cc[VPDS_MAX_DIM] = {0};
     size_t j;
     for (k = 0; k < d; k++) cc[k] = 2 * c[k];
-    cell_box(s, level + 1, cc, lo, mid);
+    vpdsi_cell_box(s, level + 1, cc, lo, mid);
     for (k = 0; k < d; k++) cc[k] = 2 * c[k] + 1;
-    cell_box(s, level + 1, cc, mid, hi);
+    vpdsi_cell_box(s, level + 1, cc, mid, hi);
     for (j = 0; j < s->n_cand; j++) {
         const double *x = s->x + (size_t)s->cand[j] * (size_t)d;
         double f = scale * vpdsi_rule_f(s->rule, s->r[s->cand[j]], r_lo), f2 = f * f;
@@ -399,16 +397,17 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
         if ((st = reserve_buffers(s, n)) != VPDS_OK) return st;
         for (j = 0; j < n; j++) {
             cell_coords(s, run->pos + j, c);
-            cell_box(s, level, c, lo, hi);
+            vpdsi_cell_box(s, level, c, lo, hi);
             for (k = 0; k < d; k++) s->buf_x[j * (size_t)d + (size_t)k] = 0.5 * (lo[k] + hi[k]);
         }
         st = vpdsi_sizing_eval(&s->sizing, s->buf_x, n, s->buf_r, s->err, sizeof s->err);
         if (st != VPDS_OK) return st;
     }
     for (j = 0; j < n; j++) {
-        double h = sqrt(cell_box(s, level, (cell_coords(s, run->pos, c), c), lo, hi));
+        double h = sqrt(vpdsi_cell_box(s, level, (cell_coords(s, run->pos, c), c), lo, hi));
         double r_lo = s->sizing.radius, r_hi = s->sizing.radius;
         uint64_t covered[4] = {0, 0, 0, 0};
+        uint8_t flag[1u << VPDS_MAX_DIM]; /* two radii: the child may hold an uncovered point */
         vpdsi_kd_samples view = vpdsi_samples_view(s);
         if (need_r) {
             r_lo = s->buf_r[j] - L * h / 2;
@@ -435,7 +434,6 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
              * (the gather above, at the larger coverage reach, found every candidate), and
              * not shown covered by a search inside them; decided before anything is kept */
             uint64_t cov_c[4] = {0, 0, 0, 0};
-            uint8_t flag[1u << VPDS_MAX_DIM];
             double scale_c = run->t * s->coverage;
             if (box_covered(s, lo, hi, r_lo, scale_c)) {
                 cov_c[0] = cov_c[1] = cov_c[2] = cov_c[3] = ~UINT64_C(0);
@@ -449,22 +447,15 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
                 if ((covered[b >> 6] >> (b & 63u) & 1u) || (cov_c[b >> 6] >> (b & 63u) & 1u))
                     continue;
                 for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
-                cell_box(s, split ? level + 1 : level, cc, clo, chi);
+                vpdsi_cell_box(s, split ? level + 1 : level, cc, clo, chi);
                 if ((st = vpdsi_uncovered_in(s, clo, chi, 0.0, &found)) != VPDS_OK) return st;
                 flag[b] = (uint8_t)found;
             }
-            run->pos++;
-            for (b = 0; b < children; b++) {
-                if (covered[b >> 6] >> (b & 63u) & 1u) continue;
-                s->next_u[run->next.count] = flag[b];
-                for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
-                vpdsi_cells_push(&run->next, d, cc);
-            }
-            continue;
         }
         run->pos++;
         for (b = 0; b < children; b++) {
             if (covered[b >> 6] >> (b & 63u) & 1u) continue;
+            if (s->two_radii) s->next_u[run->next.count] = flag[b];
             for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
             vpdsi_cells_push(&run->next, d, cc);
         }
@@ -488,7 +479,7 @@ static vpds_status vfilter_chunk(vpds_sampler *s, size_t n)
         if ((st = reserve_buffers(s, n)) != VPDS_OK) return st;
         for (j = 0; j < n; j++) {
             vpdsi_cells_get(&run->next, (size_t)run->vpos + j, d, c);
-            cell_box(s, run->next.level, c, lo, hi);
+            vpdsi_cell_box(s, run->next.level, c, lo, hi);
             for (k = 0; k < d; k++) s->buf_x[j * (size_t)d + (size_t)k] = 0.5 * (lo[k] + hi[k]);
         }
         st = vpdsi_sizing_eval(&s->sizing, s->buf_x, n, s->buf_r, s->err, sizeof s->err);
@@ -496,7 +487,7 @@ static vpds_status vfilter_chunk(vpds_sampler *s, size_t n)
     }
     for (j = 0; j < n; j++) {
         size_t i = (size_t)run->vpos;
-        double h = 0.5 * sqrt(cell_box(s, run->next.level, (vpdsi_cells_get(&run->next, i, d, c), c), lo, hi));
+        double h = 0.5 * sqrt(vpdsi_cell_box(s, run->next.level, (vpdsi_cells_get(&run->next, i, d, c), c), lo, hi));
         double r_hi = varying ? s->buf_r[j] + s->sizing.lipschitz * h : s->sizing.radius;
         for (k = 0; k < d; k++) centre[k] = 0.5 * (lo[k] + hi[k]);
         if (vpdsi_uncovered_nearest(s, centre) <= vpdsi_coverage_reach(s, r_hi) + h + s->u_half) {
@@ -531,7 +522,7 @@ static void finish_sweep(vpds_sampler *s, int split)
         for (i = 0; i < run->cur.count; i++) {
             double dg;
             vpdsi_cells_get(&run->cur, i, s->dim, c);
-            dg = sqrt(cell_box(s, run->cur.level, c, lo, hi));
+            dg = sqrt(vpdsi_cell_box(s, run->cur.level, c, lo, hi));
             if (dg > worst) worst = dg;
         }
         s->stats.delta = worst;

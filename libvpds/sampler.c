@@ -26,23 +26,28 @@ vpdsi_kd_samples vpdsi_samples_view(const vpds_sampler *s)
     return v;
 }
 
+void vpdsi_wrap_point(const vpds_sampler *s, double *x)
+{
+    int k;
+    for (k = 0; k < s->dim; k++) {
+        double P = s->period[k];
+        if (P > 0 && (x[k] < s->lo[k] || x[k] >= s->hi[k])) {
+            x[k] = s->lo[k] + fmod(x[k] - s->lo[k], P);
+            if (x[k] < s->lo[k]) x[k] += P;
+            if (x[k] >= s->hi[k]) x[k] = s->lo[k];
+        }
+    }
+}
+
 vpds_status vpdsi_radius_at(vpds_sampler *s, const double *p, double *r)
 {
     double q[VPDS_MAX_DIM];
-    int k;
     if (s->sizing.kind == VPDSI_SIZING_CONSTANT) {
         *r = s->sizing.radius;
         return VPDS_OK;
     }
-    for (k = 0; k < s->dim; k++) {
-        double P = s->period[k];
-        q[k] = p[k];
-        if (P > 0 && (q[k] < s->lo[k] || q[k] >= s->hi[k])) {
-            q[k] = s->lo[k] + fmod(q[k] - s->lo[k], P);
-            if (q[k] < s->lo[k]) q[k] += P;
-            if (q[k] >= s->hi[k]) q[k] = s->lo[k];
-        }
-    }
+    memcpy(q, p, (size_t)s->dim * sizeof(double));
+    vpdsi_wrap_point(s, q);
     return vpdsi_sizing_eval(&s->sizing, q, 1, r, s->err, sizeof s->err);
 }
 
@@ -333,10 +338,6 @@ vpds_status vpds_next(vpds_sampler *s, double t_min, double *x_out, double *t_ou
         return VPDS_ERR_STATE;
     }
     if ((st = ensure_rmax(s)) != VPDS_OK) return st;
-    if (s->grid_mode) {
-        s->grid_mode = 0;
-        vpdsi_bgrid_release(&s->grid, &s->mem);
-    }
     st = vpdsi_stream_next(s, t_min, x_out, &t);
     if (st != VPDS_OK) return st;
     *t_out = t;
@@ -405,14 +406,7 @@ vpds_status vpds_add_points(vpds_sampler *s, const double *x, const double *r, s
         for (i = 0; i < n; i++) {
             double *xi = s->x + (first + i) * (size_t)s->dim;
             memcpy(xi, x + i * (size_t)s->dim, (size_t)s->dim * sizeof(double));
-            for (k = 0; k < s->dim; k++) {
-                /* on a periodic axis a point outside the box is its image inside */
-                if (s->period[k] > 0 && (xi[k] < s->lo[k] || xi[k] >= s->hi[k])) {
-                    xi[k] = s->lo[k] + fmod(xi[k] - s->lo[k], s->period[k]);
-                    if (xi[k] < s->lo[k]) xi[k] += s->period[k];
-                    if (xi[k] >= s->hi[k]) xi[k] = s->lo[k];
-                }
-            }
+            vpdsi_wrap_point(s, xi); /* on a periodic axis: its image inside the box */
             s->r[first + i] = r ? r[i] : s->buf_r[i];
             s->t[first + i] = INFINITY;
             s->flags[first + i] = (uint8_t)(VPDSI_SAMPLE_FIXED | (r ? VPDSI_SAMPLE_OWN_RADIUS : 0u));

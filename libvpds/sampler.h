@@ -89,6 +89,8 @@ struct vpds_sampler {
 };
 
 void vpdsi_set_error(vpds_sampler *s, const char *fmt, ...);
+/* Replace coordinates outside the box on periodic axes by their image inside. */
+void vpdsi_wrap_point(const vpds_sampler *s, double *x);
 /* r at a point, wrapped into the box on periodic axes (where the sizing is defined). */
 vpds_status vpdsi_radius_at(vpds_sampler *s, const double *p, double *r);
 /* Room for `more` samples in every per-sample array and the tree; nothing changes on failure. */
@@ -100,6 +102,10 @@ void vpdsi_append_sample(vpds_sampler *s, const double *x, double r, double t, u
 vpdsi_kd_samples vpdsi_samples_view(const vpds_sampler *s);
 
 /* mps.c: Algorithm 1 */
+/* Box of the cell at `level` with integer coordinates c (the last cell of an axis ends exactly
+ * at the box's face); returns the squared diagonal. */
+double vpdsi_cell_box(const vpds_sampler *s, unsigned level, const uint64_t *c, double *lo,
+                      double *hi);
 void vpdsi_mps_reset(vpds_sampler *s, double t);
 vpds_status vpdsi_mps_run(vpds_sampler *s);
 void vpdsi_mps_release(vpds_sampler *s);

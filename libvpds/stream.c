@@ -19,7 +19,6 @@
 void vpdsi_stream_init(vpdsi_stream *st)
 {
     memset(st, 0, sizeof *st);
-    st->last_t = INFINITY;
 }
 
 void vpdsi_stream_release(vpdsi_stream *st, vpdsi_mem *m)
@@ -122,7 +121,6 @@ static vpds_status build_regions(vpds_sampler *s)
     int d = s->dim, k;
     double side = INFINITY;
     uint64_t total = 1, i, c[VPDS_MAX_DIM];
-    unsigned bits = 0;
     for (k = 0; k < d; k++)
         if (s->hi[k] - s->lo[k] < side) side = s->hi[k] - s->lo[k];
     for (k = 0; k < d; k++) {
@@ -131,7 +129,6 @@ static vpds_status build_regions(vpds_sampler *s)
         st->n0[k] = cells < 1 ? 1 : (uint64_t)cells;
         st->side0[k] = (s->hi[k] - s->lo[k]) / (double)st->n0[k];
         total *= st->n0[k];
-        bits += vpdsi_bit_length(st->n0[k]);
     }
     /* coordinates of the finest regions must fit in 64-bit integers, and stay well above
      * the precision of doubles */
@@ -140,7 +137,6 @@ static vpds_status build_regions(vpds_sampler *s)
         unsigned cap = 62 - vpdsi_bit_length(st->n0[k]);
         if (cap < st->max_level) st->max_level = cap;
     }
-    (void)bits;
     if (heap_reserve(s, (size_t)total)) {
         vpdsi_set_error(s, "out of memory for %llu stream regions", (unsigned long long)total);
         return VPDS_ERR_OUT_OF_MEMORY;
@@ -208,11 +204,10 @@ static vpds_status eval_boxes(vpds_sampler *s, const double *centres, size_t n, 
     return VPDS_OK;
 }
 
-/* Best-first search for the maximum of g over one region, stopped as soon as it is known to
- * the tolerance (*resolved) or to lie below `floor` (the next region's key). *bound is an
- * upper bound of g over the region either way; when resolved, g(y) >= *bound / (1 + VPDS_STREAM_TOLERANCE). */
+/* Best-first search for the maximum of g over one region, to the tolerance: *bound is an upper
+ * bound of g over the region and g(y) = *gy >= *bound / (1 + VPDS_STREAM_TOLERANCE). */
 static vpds_status search_region(vpds_sampler *s, const double *centre, const double *half,
-                                 double floor, double *bound, double *y, double *gy, int *resolved)
+                                 double *bound, double *y, double *gy)
 {
     vpdsi_stream *st = &s->stream;
     int d = s->dim, k;
@@ -250,13 +245,6 @@ static vpds_status search_region(vpds_sampler *s, const double *centre, const do
         if (U <= best * (1 + VPDS_STREAM_TOLERANCE)) {
             *bound = U;
             *gy = best;
-            *resolved = 1;
-            return VPDS_OK;
-        }
-        if (U < floor) {
-            *bound = U;
-            *gy = -1.0;
-            *resolved = 0;
             return VPDS_OK;
         }
         /* take the best box out, split it in 2^d */
@@ -329,15 +317,11 @@ static vpds_status draw_near(vpds_sampler *s, double t, const double *y, double 
         for (k = 0; k < d; k++) {
             double u = y[k] + (2 * vpdsi_rng_unit(&s->rng) - 1) * rho;
             d2 += (u - y[k]) * (u - y[k]);
-            if (s->period[k] > 0) {
-                while (u < s->lo[k]) u += s->period[k];
-                while (u >= s->hi[k]) u -= s->period[k];
-            } else if (u < s->lo[k] || u > s->hi[k]) {
-                outside = 1;
-            }
+            if (s->period[k] == 0 && (u < s->lo[k] || u > s->hi[k])) outside = 1;
             x[k] = u;
         }
         if (outside || d2 > rho * rho) continue;
+        vpdsi_wrap_point(s, x);
         if ((e = vpdsi_radius_at(s, x, rx)) != VPDS_OK) return e;
         f = t * s->coverage * vpdsi_rule_f(s->rule, *rx, ry);
         if (d2 > f * f) continue; /* does not cover y */
@@ -439,7 +423,7 @@ vpds_status vpdsi_stream_next(vpds_sampler *s, double t_min, double *x_out, doub
             }
         }
         if (!resolved) {
-            e = search_region(s, centre, half, -1.0, &bound, y, &gy, &resolved);
+            e = search_region(s, centre, half, &bound, y, &gy);
             if (e != VPDS_OK) {
                 heap_push(s, key, level, c, -1.0, NULL);
                 return e;
@@ -448,8 +432,9 @@ vpds_status vpdsi_stream_next(vpds_sampler *s, double t_min, double *x_out, doub
         heap_push(s, bound, level, c, gy, y);
         if (bound < next) continue;
         {
-            /* an event at t = bound (an upper bound of max g), never above the last one */
-            double t = bound < st->last_t ? bound : st->last_t, x[VPDS_MAX_DIM], rx, ry;
+            /* an event at t = bound (an upper bound of max g), never above the scale at which
+             * the set is already maximal (the last event's, or a run's) */
+            double t = bound, x[VPDS_MAX_DIM], rx, ry;
             if (s->run.phase == VPDSI_DONE && t > s->run.t) t = s->run.t;
             if (t <= t_min) return VPDS_STREAM_END;
             if ((e = vpdsi_radius_at(s, y, &ry)) != VPDS_OK) return e;
@@ -464,7 +449,6 @@ vpds_status vpdsi_stream_next(vpds_sampler *s, double t_min, double *x_out, doub
             }
             vpdsi_append_sample(s, x, rx, t, 0);
             s->stats.accepted++;
-            st->last_t = t;
             memcpy(x_out, x, (size_t)d * sizeof(double));
             *t_out = t;
             return VPDS_OK;

@@ -17,7 +17,6 @@ typedef struct vpdsi_stream {
     size_t n_boxes, cap_boxes;
     double *buf;                   /* centres and radii of one split */
     size_t cap_buf;
-    double last_t;                 /* t of the last event: t never increases */
 } vpdsi_stream;
 
 struct vpds_sampler;

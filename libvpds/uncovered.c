@@ -47,17 +47,11 @@ vpds_status vpdsi_uncovered_index(vpds_sampler *s)
     v.r = s->ur;
     v.flags = s->uf;
     for (i = 0, m = 0; i < run->next.count; i++) {
-        double half2 = 0;
+        double half2, lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
         if (!s->next_u[i]) continue;
         vpdsi_cells_get(&run->next, i, d, c);
-        for (k = 0; k < d; k++) {
-            double side = ldexp(run->side0[k], -(int)run->next.level);
-            uint64_t last = (run->n0[k] << run->next.level) - 1;
-            double lo = s->lo[k] + (double)c[k] * side;
-            double hi = c[k] == last ? s->hi[k] : lo + side;
-            s->ux[m * (size_t)d + (size_t)k] = 0.5 * (lo + hi);
-            half2 += 0.25 * (hi - lo) * (hi - lo);
-        }
+        half2 = 0.25 * vpdsi_cell_box(s, run->next.level, c, lo, hi);
+        for (k = 0; k < d; k++) s->ux[m * (size_t)d + (size_t)k] = 0.5 * (lo[k] + hi[k]);
         if (sqrt(half2) > s->u_half) s->u_half = sqrt(half2);
         s->ur[m] = 1.0;
         s->uf[m] = 0;

@@ -9,8 +9,8 @@ struct vpds_sampler;
 
 /* The region is every u with |u - a| <= t*coverage*f(r(a), r(u)) for a point a of the anchor
  * box [alo, ahi]. For a point anchor (alo == ahi, the dart y) r_anchor is r(y) and the test is
- * exact up to round-off; for a cell it bounds r over the cell from above and the region is
- * widened to its largest reach (a cell kept for nothing costs darts, never a guarantee).
+ * exact up to round-off; for a box it bounds r over the box from above and the region is
+ * widened to its largest reach (0: the box itself, the sweep's check of a cell).
  * *found is 1 when an uncovered point of the region was seen, or when the search ran out of
  * its box budget or precision (a dart then becomes a sample that may cover nothing new). */
 vpds_status vpdsi_uncovered_in(struct vpds_sampler *s, const double *alo, const double *ahi,

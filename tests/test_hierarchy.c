@@ -4,6 +4,7 @@
  * allocation failures during a stream leave a state that resumes to the same points. */
 #include "check.h"
 #include "vpds.h"
+#include "rules.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,16 +39,6 @@ static double tdist(const setup *c, const double *a, const double *b)
     return sqrt(s);
 }
 
-static double f_rule(vpds_rule rule, double rx, double ry)
-{
-    switch (rule) {
-    case VPDS_RULE_PRIOR: return rx;
-    case VPDS_RULE_CURRENT: return ry;
-    case VPDS_RULE_BIGGER: return rx > ry ? rx : ry;
-    default: return rx < ry ? rx : ry;
-    }
-}
-
 /* Conflicts among the first n samples at scale tau*inhibition*(1 - tol), insertion order. */
 static int conflicts(const setup *c, const double *x, const double *r, size_t n, double tau, double tol)
 {
@@ -56,7 +47,7 @@ static int conflicts(const setup *c, const double *x, const double *r, size_t n,
     for (j = 1; j < n; j++)
         for (i = 0; i < j; i++)
             if (tdist(c, x + i * c->dim, x + j * c->dim) <
-                tau * c->inhibition * (1 - tol) * f_rule(c->rule, r[i], r[j]))
+                tau * c->inhibition * (1 - tol) * vpdsi_rule_f(c->rule, r[i], r[j]))
                 bad++;
     return bad;
 }
@@ -74,7 +65,7 @@ static int gaps(const setup *c, const double *x, const double *r, size_t n, doub
         for (k = 0; k < c->dim; k++) y[k] = p < 8 ? (double)((p >> k) & 1) : rand() / (RAND_MAX + 1.0);
         ry = sizing ? sizing(y, NULL) : radius;
         for (i = 0; i < n && !covered; i++)
-            covered = tdist(c, x + i * c->dim, y) <= tau * c->coverage * f_rule(c->rule, r[i], ry) * (1 + 1e-12);
+            covered = tdist(c, x + i * c->dim, y) <= tau * c->coverage * vpdsi_rule_f(c->rule, r[i], ry) * (1 + 1e-12);
         bad += !covered;
     }
     return bad;
