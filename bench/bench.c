@@ -1,6 +1,7 @@
 #define _POSIX_C_SOURCE 199309L
 /* libvpds workloads for `make bench`. Prints "name n seconds peak_bytes" per line.
- * usage: bench uniform DIM RADIUS | ramp RULE | floor N DIM | grid2d RADIUS */
+ * usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION | ramp RULE | floor N DIM
+ *        | stream DIM RADIUS N STEPS (prints one line per N/STEPS samples: the cost along n) */
 #include "rng.h"
 #include "vpds.h"
 #include <stdio.h>
@@ -36,6 +37,32 @@ static int run(const char *name, vpds_desc *d)
     return 0;
 }
 
+/* The continuous stream from an empty sampler: N calls of vpds_next, timed in STEPS intervals. */
+static int stream(vpds_desc *d, size_t n, size_t steps)
+{
+    vpds_sampler *s;
+    double x[VPDS_MAX_DIM], t, t0 = now(), t_step = t0;
+    size_t i, every = n / steps ? n / steps : 1;
+    if (vpds_create(d, &s) != VPDS_OK) return 1;
+    for (i = 1; i <= n; i++) {
+        vpds_status st = vpds_next(s, 0.0, x, &t);
+        if (st != VPDS_OK) {
+            fprintf(stderr, "stream: %s\n", vpds_last_error(s));
+            return 1;
+        }
+        if (i % every == 0 || i == n) {
+            double now_s = now();
+            /* name n seconds_total peak_bytes seconds_of_this_interval t */
+            printf("stream %zu %.6f %zu %.6f %.6g\n", i, now_s - t0, vpds_get_stats(s).peak_bytes,
+                   now_s - t_step, t);
+            fflush(stdout);
+            t_step = now_s;
+        }
+    }
+    vpds_destroy(s);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     vpds_desc d = vpds_default_desc();
@@ -44,6 +71,17 @@ int main(int argc, char **argv)
         d.dim = atoi(argv[2]);
         d.radius = atof(argv[3]);
         return run("uniform", &d);
+    }
+    if (argc >= 5 && !strcmp(argv[1], "tworadii")) {
+        d.dim = atoi(argv[2]);
+        d.radius = atof(argv[3]);
+        d.inhibition = atof(argv[4]);
+        return run("tworadii", &d);
+    }
+    if (argc >= 6 && !strcmp(argv[1], "stream")) {
+        d.dim = atoi(argv[2]);
+        d.radius = atof(argv[3]);
+        return stream(&d, (size_t)atof(argv[4]), (size_t)atoi(argv[5]));
     }
     if (argc >= 3 && !strcmp(argv[1], "ramp")) {
         /* the paper's Figure 1 ramp on a box 400 times taller: about a million samples */
@@ -70,6 +108,7 @@ int main(int argc, char **argv)
         free(x);
         return 0;
     }
-    fprintf(stderr, "usage: bench uniform DIM RADIUS | ramp RULE | floor N DIM\n");
+    fprintf(stderr, "usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION | ramp RULE"
+                    " | floor N DIM | stream DIM RADIUS N STEPS\n");
     return 2;
 }

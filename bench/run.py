@@ -1,5 +1,7 @@
 """`make bench`: libvpds beside its peers on the same workloads, as ratios, in one run.
 
+`--quick`: smaller workloads; `--stream`: only the continuous-stream rows.
+
 Peers come from the registries and are installed here, into build/bench: scipy's
 qmc.PoissonDisk (PyPI), the npm package poisson-disk-sampling, the Rust crate fast_poisson.
 None of them is maximal; all are Bridson-style (biased) samplers. The floor is drawing the same
@@ -129,6 +131,36 @@ def main() -> None:
     n, sec, mem = vpds("uniform", 6, radius_for(3e3 if QUICK else 1e4, 6))
     row("libvpds 6D uniform (maximal)", n, sec, mem)
 
+    # two radii (Section 3): the exact dart test beside one radius at the same inhibition
+    n1, s1, _ = vpds("uniform", 2, 0.005)
+    n, sec, mem = vpds("tworadii", 2, 0.01, 0.5)
+    row("libvpds 2D two radii R_f=0.5 R_c, r=0.01", n, sec, mem,
+        note=f"time/sample = {(sec / n) / (s1 / n1):.1f}x one radius r=0.005")
+    stream_rows()
+
+
+def stream_rows() -> None:
+    """The continuous stream (vpds_next) from empty: samples/s and the per-sample cost along n,
+    beside a maximal run of about as many samples (no registry package streams a continuous
+    farthest-point order, so the run is the reference)."""
+    for dim, n_total in ((2, 1e4 if QUICK else 1e5), (3, 3e3 if QUICK else 1e5)):
+        steps = 10
+        lines = sh([str(OUT / "bench"), "stream", str(dim), "1", f"{n_total:g}", str(steps)])
+        pts = [ln.split() for ln in lines.splitlines()]
+        n, total, mem = int(pts[-1][1]), float(pts[-1][2]), int(pts[-1][3])
+        t_last = float(pts[-1][5])
+        costs = [float(p[4]) / (n / steps) * 1e6 for p in pts]
+        rn, rsec, _ = vpds("uniform", dim, t_last)
+        print(f"libvpds {dim}D stream from empty, {n:,d} calls of vpds_next: {total:.2f} s, "
+              f"{n / total:,.0f} samples/s, {mem / n:.0f} B/sample at the end; "
+              f"a maximal run at its last scale: {rn:,d} samples at {rn / rsec:,.0f}/s "
+              f"(stream/run time per sample {(total / n) / (rsec / rn):.1f}x)", flush=True)
+        print("   us/sample per tenth of the stream: " + " ".join(f"{c:.0f}" for c in costs),
+              flush=True)
+
 
 if __name__ == "__main__":
-    main()
+    if "--stream" in sys.argv:  # only the stream rows (no peers needed)
+        stream_rows()
+    else:
+        main()

@@ -107,10 +107,10 @@ static void check_samples(const vpds_sampler *s, const double *lo, const double 
     check_samples_on(s, lo, hi, rule, inhibition, NULL);
 }
 
-/* After a completed run: random probes in the box are covered (for a constant radius, where the
- * harness knows r at any point). */
-static void check_covered(const vpds_sampler *s, const double *lo, const double *hi, double radius,
-                          double scale, bytes_t *b)
+/* After a completed run: random probes in the box are covered at scale * f (for a constant
+ * radius, where the harness knows r at any point), toroidally on periodic axes. */
+static void check_covered_on(const vpds_sampler *s, const double *lo, const double *hi,
+                             double radius, double scale, const int *periodic, bytes_t *b)
 {
     size_t n = vpds_count(s), i, p;
     int d = vpds_dim(s), k;
@@ -120,10 +120,20 @@ static void check_covered(const vpds_sampler *s, const double *lo, const double 
         for (k = 0; k < d; k++) y[k] = lo[k] + (hi[k] - lo[k]) * (double)((take_u8(b) * 131 + p * 37) % 257) / 256.0;
         for (i = 0; i < n; i++) {
             double d2 = 0, f = scale * (r[i] < radius ? r[i] : radius);
-            for (k = 0; k < d; k++) d2 += (y[k] - x[i * d + k]) * (y[k] - x[i * d + k]);
+            for (k = 0; k < d; k++) {
+                double e = fabs(y[k] - x[i * d + k]), P = hi[k] - lo[k];
+                if (periodic && periodic[k] && e > 0.5 * P) e = P - e;
+                d2 += e * e;
+            }
             if (sqrt(d2) - f < best) best = sqrt(d2) - f;
         }
         FUZZ_ASSERT(n > 0 && best <= 1e-9 * radius, "probe %zu uncovered by %g", p, best);
     }
+}
+
+static void check_covered(const vpds_sampler *s, const double *lo, const double *hi, double radius,
+                          double scale, bytes_t *b)
+{
+    check_covered_on(s, lo, hi, radius, scale, NULL, b);
 }
 #endif

@@ -1,5 +1,8 @@
 /* Descriptor validation, create and run with arbitrary parameters (bounded so that each input
- * stays small), then the output's invariants: conflict-free, inside the box, covered. */
+ * stays small), then the output's invariants: conflict-free, inside the box, covered.
+ * Modes (first byte): 255 any dim, 254 any box, 253 any rule, 252 any radius, 251 an L too
+ * small, 250 any inhibition, 249 a bad struct size, 248 periodic axes, 247 periodic axes and two
+ * radii (inhibition < coverage). */
 #include "fuzz_common.h"
 
 typedef struct { double a, slope; int dim; } ramp_t;
@@ -21,7 +24,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     bytes_t b = {data, size};
     vpds_desc d = vpds_default_desc();
     double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], vol = 1;
-    int k, kind, calls;
+    int k, kind, calls, per[VPDS_MAX_DIM];
+    const int *periodic = NULL;
     char msg[512];
     vpds_sampler *s = NULL;
     vpds_status st;
@@ -59,6 +63,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     if (mode == 250) d.inhibition = take_double(&b, 0.1, 2, 1);
     if (mode == 249) d.struct_size ^= 8;
+    if (mode == 248 || mode == 247) {
+        uint8_t bits = take_u8(&b);
+        /* the ramp is not periodic along axis 0: keep that axis a plain one with a sizing */
+        for (k = 0; k < VPDS_MAX_DIM; k++) per[k] = (bits >> k) & 1 && !(k == 0 && kind > 0);
+        d.periodic = periodic = per;
+        if (mode == 247) d.inhibition = take_double(&b, 0.3, 1, 0);
+    }
     st = vpds_validate(&d, msg, sizeof msg);
     check_status(st);
     {
@@ -71,13 +82,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     for (calls = 0; calls < 100 && (st = vpds_run(s)) == VPDS_PAUSED; calls++) {}
     check_status(st);
-    check_samples(s, lo, hi, d.rule, d.inhibition);
+    check_samples_on(s, lo, hi, d.rule, d.inhibition, periodic);
     if (st == VPDS_OK) {
         FUZZ_ASSERT(vpds_get_stats(s).maximal, "run returned OK but not maximal");
-        if (kind == 0) check_covered(s, lo, hi, d.radius, 1.0, &b);
+        if (kind == 0) check_covered_on(s, lo, hi, d.radius, d.coverage, periodic, &b);
     } else if (st != VPDS_PAUSED) {
         /* the documented ways a valid descriptor's run can stop */
+        /* with a sizing, a periodic side too short for r_max is found at run time */
         FUZZ_ASSERT((st == VPDS_ERR_LIPSCHITZ && mode == 251) || st == VPDS_ERR_OVERFLOW ||
+                    (st == VPDS_ERR_INVALID_ARGUMENT && periodic && kind > 0) ||
                     st == VPDS_ERR_OUT_OF_MEMORY, "run failed: %s", vpds_last_error(s));
         FUZZ_ASSERT(vpds_last_error(s)[0] != 0, "error %d without a message", (int)st);
     }

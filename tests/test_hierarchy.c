@@ -20,6 +20,23 @@ static double wave(const double *x, void *u)
     return 0.03 + 0.01 * sin(2 * 3.14159265358979323846 * x[0]);
 }
 
+/* An allocator that fails its fail_at-th call (0: never) and counts the bytes it holds. */
+typedef struct {
+    size_t calls, fail_at, live;
+} failing_alloc;
+static void *fa_alloc(size_t size, void *u)
+{
+    failing_alloc *a = (failing_alloc *)u;
+    if (++a->calls == a->fail_at) return NULL;
+    a->live += size;
+    return malloc(size);
+}
+static void fa_free(void *p, size_t size, void *u)
+{
+    ((failing_alloc *)u)->live -= size;
+    free(p);
+}
+
 typedef struct {
     int dim;
     const int *periodic;
@@ -227,6 +244,55 @@ int main(void)
             CHECK(memcmp(x1, x2, sizeof x1) == 0 && t1 == t2);
         }
         vpds_destroy(s);
+    }
+
+    /* allocation failures during a stream (one and two radii, from empty): each allocation of
+     * the stream fails once in turn; a retry gives the points and t of a stream without them */
+    {
+        int two;
+        for (two = 0; two < 2; two++) {
+            enum { N = 250 };
+            double ref[N * 2], ref_t[N], x[2], t;
+            failing_alloc fa;
+            vpds_desc d = vpds_default_desc();
+            vpds_sampler *s;
+            size_t i, k, total, failures = 0, stride;
+            d.radius = 0.05;
+            d.inhibition = two ? 0.5 : 1;
+            d.seed = 11;
+            d.allocator.alloc = fa_alloc;
+            d.allocator.free = fa_free;
+            d.allocator.user = &fa;
+            memset(&fa, 0, sizeof fa);
+            CHECK(vpds_create(&d, &s) == VPDS_OK);
+            for (i = 0; i < N; i++) CHECK(vpds_next(s, 0, ref + 2 * i, ref_t + i) == VPDS_OK);
+            vpds_destroy(s);
+            CHECK(fa.live == 0);
+            total = fa.calls;
+            stride = quick ? total / 8 + 1 : 1;
+            for (k = 2; k <= total; k += stride) { /* the first allocation is vpds_create's own */
+                memset(&fa, 0, sizeof fa);
+                CHECK(vpds_create(&d, &s) == VPDS_OK);
+                fa.fail_at = k;
+                for (i = 0; i < N; i++) {
+                    vpds_status st;
+                    size_t n = vpds_count(s);
+                    while ((st = vpds_next(s, 0, x, &t)) == VPDS_ERR_OUT_OF_MEMORY) {
+                        CHECK(vpds_count(s) == n && strlen(vpds_last_error(s)) > 0);
+                        failures++;
+                    }
+                    CHECK_MSG(st == VPDS_OK && memcmp(x, ref + 2 * i, sizeof x) == 0 && t == ref_t[i],
+                              "%s radii: sample %zu differs after failing allocation %zu",
+                              two ? "two" : "one", i, k);
+                    if (st != VPDS_OK) break;
+                }
+                vpds_destroy(s);
+                CHECK_MSG(fa.live == 0, "leak after failing allocation %zu", k);
+            }
+            CHECK(failures > 0);
+            printf("stream allocation failures (%s): %zu allocations, %zu failed once each\n",
+                   two ? "two radii" : "one radius", total, failures);
+        }
     }
     CHECK_DONE();
 }

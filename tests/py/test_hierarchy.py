@@ -12,8 +12,6 @@ passing run above means something.
 """
 import itertools
 import math
-import re
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,17 +20,7 @@ import vpds
 from vpds import analysis as C
 
 
-def stream_tolerance() -> float:
-    """vpds.STREAM_TOLERANCE, else VPDS_STREAM_TOLERANCE from this checkout's vpds.h."""
-    if hasattr(vpds, "STREAM_TOLERANCE"):
-        return float(vpds.STREAM_TOLERANCE)
-    header = Path(__file__).resolve().parents[2] / "include" / "vpds.h"
-    found = re.search(r"#define\s+VPDS_STREAM_TOLERANCE\s+([0-9.eE+-]+)",
-                      header.read_text()) if header.exists() else None
-    return float(found.group(1)) if found else 1e-6
-
-
-TOL = stream_tolerance()
+TOL = vpds.STREAM_TOLERANCE
 N_STREAM = 10_000
 
 

@@ -9,5 +9,7 @@ from ._core import (RULES, PoissonDisk, SizingGrid, VpdsError, VpdsSizingError, 
 from ._vpds import ffi as _ffi, lib as _lib
 
 __version__ = _ffi.string(_lib.vpds_version_string()).decode()
+#: relative tolerance of the continuous stream: t is an upper bound, conflicts hold at t(1 - eps)
+STREAM_TOLERANCE: float = float(_lib.VPDS_STREAM_TOLERANCE)
 __all__ = ["PoissonDisk", "SizingGrid", "VpdsError", "VpdsValueError", "VpdsSizingError",
-           "VpdsUnsupportedError", "VpdsStateError", "RULES", "__version__"]
+           "VpdsUnsupportedError", "VpdsStateError", "RULES", "STREAM_TOLERANCE", "__version__"]

@@ -26,6 +26,8 @@ def declarations_from_header(path: Path) -> str:
 
 ffibuilder = FFI()
 ffibuilder.cdef(declarations_from_header(ROOT / "include" / "vpds.h"))
+# floating-point macros of vpds.h (cffi reads only integer #defines by itself)
+ffibuilder.cdef("static const double VPDS_STREAM_TOLERANCE;")
 # the batched sizing callback that runs Python code (see vpds._core.vpds_py_sizing_batch)
 ffibuilder.cdef('''extern "Python" int vpds_py_sizing_batch(const double *x, size_t n, double *r_out,
                                                       void *user);''')
