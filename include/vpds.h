@@ -63,7 +63,9 @@ typedef enum vpds_status {
     VPDS_ERR_SIZING = -5,           /* the sizing function returned NaN, Inf, zero or < 0 */
     VPDS_ERR_LIPSCHITZ = -6,        /* the sizing function was seen to break the declared L */
     VPDS_ERR_STATE = -7,            /* the call is not valid in the sampler's current state */
-    VPDS_ERR_OVERFLOW = -8          /* the request would overflow a size computation */
+    VPDS_ERR_OVERFLOW = -8,         /* the request would overflow a size computation */
+    VPDS_ERR_DOMAIN = -9            /* the domain function returned NaN, broke 1-Lipschitz, or
+                                       its domain holds no point the sampler can reach */
 } vpds_status;
 
 /* The distance function f of Section 5 (Table 1). */
@@ -88,7 +90,8 @@ typedef struct vpds_allocator {
 typedef double (*vpds_sizing_fn)(const double *x, void *user);
 /* r at n points (x holds n*dim doubles); write n radii to r_out; return 0, or non-zero to fail. */
 typedef int (*vpds_sizing_batch_fn)(const double *x, size_t n, double *r_out, void *user);
-/* Signed distance to the domain's boundary, negative inside, 1-Lipschitz. */
+/* Signed distance to the domain's boundary, negative inside (a point with 0 is inside too),
+ * 1-Lipschitz; +INFINITY is allowed far outside. The domain is box ∩ {x : domain(x) <= 0}. */
 typedef double (*vpds_domain_fn)(const double *x, void *user);
 
 /* Passed to the progress callback between chunks of work. */
@@ -157,7 +160,8 @@ typedef struct vpds_stats {
                                   (0: none); the set is then covered at t*coverage*f + delta */
     double t;                  /* current scale */
     int maximal;               /* non-zero when the last run completed */
-    uint64_t reserved[6];
+    uint64_t domain_calls;     /* points at which the domain function was evaluated */
+    uint64_t reserved[5];
 } vpds_stats;
 
 typedef struct vpds_sampler vpds_sampler;

@@ -68,9 +68,6 @@ vpds_status vpds_validate(const vpds_desc *d, char *msg, size_t cap)
     if (d->inhibition > d->coverage)
         REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.inhibition = %g > desc.coverage = %g: need R_f <= R_c",
                d->inhibition, d->coverage);
-    if (d->domain)
-        REFUSE(VPDS_ERR_UNSUPPORTED, "desc.domain: domains other than the box are not supported by "
-               "this version");
     if ((d->radius_min != 0 && !vpdsi_radius_ok(d->radius_min)) ||
         (d->radius_max != 0 && !vpdsi_radius_ok(d->radius_max)))
         REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.radius_min = %g, desc.radius_max = %g: must be 0 or "

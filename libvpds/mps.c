@@ -217,6 +217,16 @@ static int32_t grid_conflict(const vpds_sampler *s, const double *y, double reac
     return -1;
 }
 
+/* An error at dart j of a chunk: keep the darts before it, as a pause would, and spend no
+ * draw on the rest (a retry throws the same darts). */
+static void keep_darts_before(vpds_sampler *s, const vpdsi_rng *start, size_t j, int weighted)
+{
+    s->rng = *start;
+    draw_darts(s, &s->rng, j, s->buf_x, weighted ? s->buf_u : NULL);
+    s->run.darts_left -= j;
+    s->stats.darts += j;
+}
+
 static vpds_status darts_chunk(vpds_sampler *s, size_t n)
 {
     int d = s->dim;
@@ -287,12 +297,16 @@ static vpds_status darts_chunk(vpds_sampler *s, size_t n)
                             " (%s), distance %.17g, slope %.17g", s->sizing.lipschitz,
                             s->buf_r[j], py, s->r[witness], px, dist,
                             fabs(s->buf_r[j] - s->r[witness]) / dist);
-            /* keep the darts before this one, as a pause would */
-            s->rng = start;
-            draw_darts(s, &s->rng, j, s->buf_x, weighted ? s->buf_u : NULL);
-            s->run.darts_left -= j;
-            s->stats.darts += j;
+            keep_darts_before(s, &start, j, weighted);
             return VPDS_ERR_LIPSCHITZ;
+        }
+        if (hit == -1 && s->domain) {
+            double phi;
+            if ((st = vpdsi_domain_at(s, y, &phi)) != VPDS_OK) {
+                keep_darts_before(s, &start, j, weighted);
+                return st;
+            }
+            if (phi > 0) hit = -4; /* outside the domain: rejected, as uniform over it wants */
         }
         if (hit == -1 && s->two_radii) {
             /* Section 3.1, first option: the dart must cover a point not yet covered */
@@ -303,10 +317,7 @@ static vpds_status darts_chunk(vpds_sampler *s, size_t n)
             else
                 st = vpdsi_uncovered_in(s, y, y, s->buf_r[j], &found);
             if (st != VPDS_OK) {
-                s->rng = start; /* keep the darts before this one, as a pause would */
-                draw_darts(s, &s->rng, j, s->buf_x, weighted ? s->buf_u : NULL);
-                s->run.darts_left -= j;
-                s->stats.darts += j;
+                keep_darts_before(s, &start, j, weighted);
                 return st;
             }
             if (!found) hit = -3;
@@ -369,6 +380,38 @@ static void children_covered(const vpds_sampler *s, unsigned level, const uint64
     }
 }
 
+/* A cell that straddles the domain's boundary (centre's sdf phi): mark as covered each kept
+ * child that lies outside the domain, and, with one radius, each whose part inside the domain
+ * is covered by the union of disks (a search inside it); else such children would split along
+ * the boundary down to the precision limit. Without a split the "child" is the cell itself. */
+static vpds_status drop_outside_children(vpds_sampler *s, unsigned level, const uint64_t *c,
+                                         int split, const double *centre, double phi,
+                                         uint64_t *covered)
+{
+    int d = s->dim, k;
+    unsigned children = split ? 1u << d : 1u, b;
+    uint64_t cc[VPDS_MAX_DIM];
+    vpds_status st;
+    for (b = 0; b < children; b++) {
+        double clo[VPDS_MAX_DIM], chi[VPDS_MAX_DIM], cm[VPDS_MAX_DIM], half, phi_c = phi;
+        int found = 1;
+        if (covered[b >> 6] >> (b & 63u) & 1u) continue;
+        for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
+        half = 0.5 * sqrt(vpdsi_cell_box(s, split ? level + 1 : level, cc, clo, chi));
+        for (k = 0; k < d; k++) cm[k] = 0.5 * (clo[k] + chi[k]);
+        if (split) {
+            if ((st = vpdsi_domain_at(s, cm, &phi_c)) != VPDS_OK) return st;
+            if ((st = vpdsi_domain_check_pair(s, centre, phi, cm, phi_c)) != VPDS_OK) return st;
+        }
+        if (phi_c <= -half) continue; /* inside, whole: the usual rules apply */
+        if (phi_c <= half && !s->two_radii &&
+            (st = vpdsi_uncovered_in(s, clo, chi, 0.0, &found)) != VPDS_OK)
+            return st;
+        if (phi_c > half || !found) covered[b >> 6] |= UINT64_C(1) << (b & 63u);
+    }
+    return VPDS_OK;
+}
+
 /* Sweep n cells from run->pos: drop covered ones, keep the others (split: their uncovered
  * children) in run->next. run->pos advances cell by cell, so an error mid-chunk loses nothing. */
 static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
@@ -382,7 +425,7 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
     /* a cell is dropped inside one inhibition disk (with one radius: one coverage disk) */
     double scale = run->t * s->inhibition, L = s->sizing.lipschitz;
     uint64_t c[VPDS_MAX_DIM], cc[VPDS_MAX_DIM];
-    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], centre[VPDS_MAX_DIM], phi = -INFINITY;
     size_t j, need;
     vpds_status st;
     if (vpdsi_mul_size(n, children, &need) ||
@@ -424,11 +467,22 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
             vpdsi_set_error(s, "out of memory gathering the samples near a cell");
             return VPDS_ERR_OUT_OF_MEMORY;
         }
+        if (s->domain) {
+            for (k = 0; k < d; k++) centre[k] = 0.5 * (lo[k] + hi[k]);
+            if ((st = vpdsi_domain_at(s, centre, &phi)) != VPDS_OK) return st;
+            if (phi > 0.5 * h) { /* outside the domain, whole */
+                run->pos++;
+                continue;
+            }
+        }
         if (box_covered(s, lo, hi, r_lo, scale)) {
             run->pos++;
             continue;
         }
         if (split) children_covered(s, level, c, r_lo, scale, covered);
+        if (s->domain && phi > -0.5 * h &&
+            (st = drop_outside_children(s, level, c, split, centre, phi, covered)) != VPDS_OK)
+            return st;
         if (s->two_radii) {
             /* which kept children may hold an uncovered point: not inside one coverage disk
              * (the gather above, at the larger coverage reach, found every candidate), and
@@ -552,6 +606,13 @@ vpds_status vpdsi_mps_run(vpds_sampler *s)
     }
     for (;;) {
         uint64_t limit = CHUNK, before;
+        if (run->phase == VPDSI_DONE && s->n == 0 && s->domain) {
+            /* nothing to sample: say so, and leave the sampler as it was */
+            vpdsi_mps_reset(s, run->t);
+            vpdsi_set_error(s, "domain: no point of the box with sdf <= 0 was found (the domain is"
+                            " empty, or too thin for darts to land in)");
+            return VPDS_ERR_DOMAIN;
+        }
         if (run->phase == VPDSI_DONE) return VPDS_OK;
         if (s->budget && work >= s->budget) return VPDS_PAUSED;
         if (s->budget && s->budget - work < limit) limit = s->budget - work;

@@ -125,6 +125,8 @@ vpds_status vpds_create(const vpds_desc *d, vpds_sampler **out)
         if (s->period[k] > 0) s->any_periodic = 1;
     }
     s->weighted = d->weighted;
+    s->domain = d->domain;
+    s->domain_user = d->domain_user;
     s->budget = d->budget;
     s->progress = d->progress;
     s->progress_user = d->progress_user;
@@ -446,6 +448,7 @@ vpds_stats vpds_get_stats(const vpds_sampler *s)
     st.bytes_held = s->mem.held;
     st.peak_bytes = s->mem.peak;
     st.sizing_calls = s->sizing.calls;
+    st.domain_calls = s->domain_calls;
     st.t = s->run.t;
     st.maximal = s->run.phase == VPDSI_DONE;
     return st;

@@ -3,6 +3,7 @@
 #define VPDS_SAMPLER_H
 #include "bgrid.h"
 #include "cells.h"
+#include "domain.h"
 #include "kdtree.h"
 #include "rng.h"
 #include "sizing.h"
@@ -48,6 +49,9 @@ struct vpds_sampler {
     int any_periodic;
     int weighted;
     vpdsi_sizing sizing;
+    vpds_domain_fn domain;         /* NULL: the whole box */
+    void *domain_user;
+    uint64_t domain_calls;
     vpdsi_rng rng;
     uint64_t budget;
     vpds_progress_fn progress;

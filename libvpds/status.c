@@ -15,6 +15,8 @@ const char *vpds_status_string(vpds_status status)
     case VPDS_ERR_LIPSCHITZ: return "VPDS_ERR_LIPSCHITZ: the sizing function breaks the declared Lipschitz constant";
     case VPDS_ERR_STATE: return "VPDS_ERR_STATE: not valid in the sampler's current state";
     case VPDS_ERR_OVERFLOW: return "VPDS_ERR_OVERFLOW: a size computation would overflow";
+    case VPDS_ERR_DOMAIN: return "VPDS_ERR_DOMAIN: the domain function returned NaN, is not "
+                                 "1-Lipschitz, or its domain is empty";
     }
     return "unknown vpds_status";
 }

@@ -14,6 +14,7 @@
 #include <math.h>
 #include <string.h>
 
+#define STREAM_FIRST_TRIES 1000000 /* uniform draws for a first sample inside the domain */
 #define STREAM_SPLIT 1.0 /* a region splits while its half-diagonal exceeds STREAM_SPLIT * t * coverage * r */
 
 void vpdsi_stream_init(vpdsi_stream *st)
@@ -181,10 +182,19 @@ static vpds_status eval_boxes(vpds_sampler *s, const double *centres, size_t n, 
     }
     for (j = 0; j < n; j++) {
         const double *c = centres + j * (size_t)d;
-        double rc = st->buf[j], r_lo = rc - L * h;
+        double rc = st->buf[j], r_lo = rc - L * h, phi = 0;
         int32_t arg;
-        double q = vpdsi_kd_min_ratio(&s->tree, &v, c, 0.0, rc, (int)s->rule, &arg);
-        g[j] = q / s->coverage;
+        double q;
+        if (s->domain) {
+            /* a box outside the domain holds no candidate; a centre outside is none itself */
+            if ((e = vpdsi_domain_at(s, c, &phi)) != VPDS_OK) return e;
+            if (phi > h || (h == 0 && phi > 0)) {
+                g[j] = ub[j] = -1;
+                continue;
+            }
+        }
+        q = vpdsi_kd_min_ratio(&s->tree, &v, c, 0.0, rc, (int)s->rule, &arg);
+        g[j] = phi > 0 ? -1 : q / s->coverage;
         if (arg < 0) {
             ub[j] = INFINITY;
             continue;
@@ -242,7 +252,13 @@ static vpds_status search_region(vpds_sampler *s, const double *centre, const do
         U = top;
         if (best > U) U = best;
         if (extra > U) U = extra;
-        if (U <= best * (1 + VPDS_STREAM_TOLERANCE)) {
+        if (best < 0 && (U < 0 || st->n_boxes == 0)) {
+            /* no point of the domain in the region (or none found above the precision) */
+            *bound = 0;
+            *gy = -1;
+            return VPDS_OK;
+        }
+        if (U <= best * (1 + VPDS_STREAM_TOLERANCE) || st->n_boxes == 0) {
             *bound = U;
             *gy = best;
             return VPDS_OK;
@@ -276,6 +292,7 @@ static vpds_status search_region(vpds_sampler *s, const double *centre, const do
         }
         for (j = 0; j < children; j++) {
             double *r;
+            if (ubs[j] < 0) continue; /* outside the domain */
             if (ubs[j] <= best * (1 + VPDS_STREAM_TOLERANCE)) {
                 /* cannot beat the best by more than the tolerance: keep only its bound */
                 if (ubs[j] > extra) extra = ubs[j];
@@ -322,6 +339,11 @@ static vpds_status draw_near(vpds_sampler *s, double t, const double *y, double 
         }
         if (outside || d2 > rho * rho) continue;
         vpdsi_wrap_point(s, x);
+        if (s->domain) {
+            double phi;
+            if ((e = vpdsi_domain_at(s, x, &phi)) != VPDS_OK) return e;
+            if (phi > 0) continue;
+        }
         if ((e = vpdsi_radius_at(s, x, rx)) != VPDS_OK) return e;
         f = t * s->coverage * vpdsi_rule_f(s->rule, *rx, ry);
         if (d2 > f * f) continue; /* does not cover y */
@@ -351,10 +373,25 @@ vpds_status vpdsi_stream_next(vpds_sampler *s, double t_min, double *x_out, doub
     if (s->n == 0) {
         /* the first sample: uniform over the box, at t = +infinity */
         double x[VPDS_MAX_DIM], r;
+        long tries;
         if (t_min >= INFINITY) return VPDS_STREAM_END;
-        for (k = 0; k < d; k++) {
-            double u = s->lo[k] + vpdsi_rng_unit(&s->rng) * (s->hi[k] - s->lo[k]);
-            x[k] = u > s->hi[k] ? s->hi[k] : u;
+        for (tries = 0;; tries++) { /* uniform over the domain, by rejection from the box */
+            double phi = 0;
+            if (tries == STREAM_FIRST_TRIES) {
+                s->rng = start;
+                vpdsi_set_error(s, "domain: none of %d uniform points of the box has sdf <= 0 (the"
+                                " domain is empty, or too small for a first sample)", STREAM_FIRST_TRIES);
+                return VPDS_ERR_DOMAIN;
+            }
+            for (k = 0; k < d; k++) {
+                double u = s->lo[k] + vpdsi_rng_unit(&s->rng) * (s->hi[k] - s->lo[k]);
+                x[k] = u > s->hi[k] ? s->hi[k] : u;
+            }
+            if (s->domain && (e = vpdsi_domain_at(s, x, &phi)) != VPDS_OK) {
+                s->rng = start;
+                return e;
+            }
+            if (phi <= 0) break;
         }
         if ((e = vpdsi_radius_at(s, x, &r)) != VPDS_OK) {
             s->rng = start;

@@ -1,6 +1,7 @@
 /* Branch-and-bound over boxes of the region's bounding box: a box is dropped when it misses
- * the region or lies inside one sample's coverage disk; a box point inside the region and
- * outside every coverage disk is an uncovered witness; anything else splits into 2^d. Boxes
+ * the region, lies outside the domain or inside one sample's coverage disk; a box point inside
+ * the region and the domain and outside every coverage disk is an uncovered witness; anything
+ * else splits into 2^d. Boxes
  * live in coordinates around the anchor; on a periodic axis the kd-tree wraps them. */
 #include "uncovered.h"
 #include "rules.h"
@@ -131,11 +132,16 @@ vpds_status vpdsi_uncovered_in(vpds_sampler *s, const double *alo, const double 
             diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
         }
         if (gap2 > reach * reach) continue; /* misses the region */
-        if (s->u_ready) {
-            /* no cell that may hold an uncovered point meets the box */
-            double c2[VPDS_MAX_DIM];
+        if (s->u_ready || s->domain) {
+            double c2[VPDS_MAX_DIM], phi;
             for (k = 0; k < d; k++) c2[k] = 0.5 * (lo[k] + hi[k]);
-            if (vpdsi_uncovered_nearest(s, c2) > 0.5 * sqrt(diag2) + s->u_half) continue;
+            /* no cell that may hold an uncovered point meets the box */
+            if (s->u_ready && vpdsi_uncovered_nearest(s, c2) > 0.5 * sqrt(diag2) + s->u_half) continue;
+            /* the box lies outside the domain: nothing there needs covering */
+            if (s->domain) {
+                if ((st = vpdsi_domain_at(s, c2, &phi)) != VPDS_OK) return st;
+                if (phi > 0.5 * sqrt(diag2)) continue;
+            }
         }
         if ((st = vpdsi_radius_at(s, p, &rp)) != VPDS_OK) return st;
         if (point) {
@@ -152,8 +158,13 @@ vpds_status vpdsi_uncovered_in(vpds_sampler *s, const double *alo, const double 
         }
         if (in_region &&
             vpdsi_kd_conflict(&s->tree, &view, p, rp, (int)s->rule, scale, -1.0, &w) == -1) {
-            *found = 1; /* p is uncovered: no sample within t*coverage*f of it */
-            return VPDS_OK;
+            /* p is uncovered: no sample within t*coverage*f of it; a witness if in the domain */
+            double phi = 0;
+            if (s->domain && (st = vpdsi_domain_at(s, p, &phi)) != VPDS_OK) return st;
+            if (phi <= 0) {
+                *found = 1;
+                return VPDS_OK;
+            }
         }
         diag = sqrt(diag2);
         r_lo = rp - L * diag;
