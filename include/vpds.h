@@ -231,6 +231,55 @@ VPDS_API double vpds_grid_eval(const vpds_grid *grid, const double *x);
 VPDS_API const double *vpds_grid_values(const vpds_grid *grid);
 VPDS_API size_t vpds_grid_size(const vpds_grid *grid);
 
+/* ---- Built-in domains: set desc.domain = vpds_polygon_sdf (or vpds_mask_sdf) and
+ * desc.domain_user = the object; it must outlive the samplers that use it. */
+
+/* A 2D polygon set with holes: rings of vertices, closed implicitly; a point is inside when a
+ * ray from it crosses the rings an odd number of times (a ring inside another is a hole). */
+typedef struct vpds_polygon vpds_polygon;
+typedef struct vpds_polygon_desc {
+    uint32_t cookie;
+    uint32_t struct_size;
+    const double *xy;         /* x0, y0, x1, y1, ... of every ring, one ring after the other */
+    const size_t *ring_sizes; /* vertices of each ring (>= 3) */
+    size_t n_rings;
+    vpds_allocator allocator;
+} vpds_polygon_desc;
+
+VPDS_API vpds_polygon_desc vpds_default_polygon_desc(void);
+/* Refuses non-finite vertices, repeated consecutive vertices, and edges that cross or touch
+ * (within a ring or between rings), naming the edges and the point. */
+VPDS_API vpds_status vpds_polygon_validate(const vpds_polygon_desc *desc, char *msg, size_t cap);
+VPDS_API vpds_status vpds_polygon_create(const vpds_polygon_desc *desc, vpds_polygon **out);
+VPDS_API void vpds_polygon_destroy(vpds_polygon *polygon);
+/* Exact signed distance to the rings' edges, negative inside (a vpds_domain_fn; O(edges)). */
+VPDS_API double vpds_polygon_sdf(const double *x, void *polygon);
+
+/* A mask over the box: values on a grid of cells (C order, axis 0 slowest); a cell is inside
+ * when its value >= threshold. Its domain function is the exact Euclidean distance transform
+ * between inside and outside cell centres, halved and interpolated multilinearly, divided by
+ * the interpolant's exact Lipschitz constant where that exceeds 1: the boundary lies halfway
+ * between inside and outside centres. */
+typedef struct vpds_mask vpds_mask;
+typedef struct vpds_mask_desc {
+    uint32_t cookie;
+    uint32_t struct_size;
+    int dim;              /* 1..VPDS_MAX_DIM (default 2) */
+    const size_t *shape;  /* cells per axis (>= 2 each) */
+    const double *values; /* prod(shape) values; copied */
+    double threshold;     /* inside: value >= threshold (default 0.5) */
+    const double *lo;     /* dim doubles: the box the mask covers (NULL: all 0) */
+    const double *hi;     /* (NULL: all 1) */
+    vpds_allocator allocator;
+} vpds_mask_desc;
+
+VPDS_API vpds_mask_desc vpds_default_mask_desc(void);
+/* Refuses NaN values, a non-finite threshold and a mask with no inside cell. */
+VPDS_API vpds_status vpds_mask_validate(const vpds_mask_desc *desc, char *msg, size_t cap);
+VPDS_API vpds_status vpds_mask_create(const vpds_mask_desc *desc, vpds_mask **out);
+VPDS_API void vpds_mask_destroy(vpds_mask *mask);
+VPDS_API double vpds_mask_sdf(const double *x, void *mask);
+
 #ifdef __cplusplus
 }
 #endif

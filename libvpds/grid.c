@@ -104,14 +104,19 @@ static void grid_refresh(vpds_grid *g)
 
 vpds_status vpds_grid_create(const vpds_grid_desc *d, vpds_grid **out)
 {
-    vpdsi_mem m;
-    vpds_grid *g;
-    size_t k, s;
     vpds_status st;
     if (!out) return VPDS_ERR_INVALID_ARGUMENT;
     *out = NULL;
     st = vpds_grid_validate(d, NULL, 0);
     if (st != VPDS_OK) return st;
+    return vpdsi_grid_build(d, out);
+}
+
+vpds_status vpdsi_grid_build(const vpds_grid_desc *d, vpds_grid **out)
+{
+    vpdsi_mem m;
+    vpds_grid *g;
+    size_t k, s;
     vpdsi_mem_init(&m, &d->allocator);
     g = (vpds_grid *)vpdsi_mem_alloc(&m, sizeof *g);
     if (!g) return VPDS_ERR_OUT_OF_MEMORY;

@@ -18,6 +18,9 @@ struct vpds_grid {
     vpdsi_mem mem;
 };
 
+/* The grid of a descriptor whose layout is known valid; its values may be any finite numbers
+ * (the mask domain's signed distances use this). */
+vpds_status vpdsi_grid_build(const vpds_grid_desc *d, vpds_grid **out);
 /* A copy of g made with the allocator m (used by the sampler, which owns its copy). */
 vpds_status vpdsi_grid_clone(const vpds_grid *g, const vpds_allocator *a, vpds_grid **out);
 #endif

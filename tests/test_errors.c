@@ -89,7 +89,6 @@ int main(void)
     CHECK(vpds_create(&d, &s) == VPDS_OK);
     CHECK(vpds_run(s) == VPDS_ERR_SIZING && strstr(vpds_last_error(s), "below radius_min = 0.1"));
     vpds_destroy(s);
-    d = vpds_default_desc(); d.domain = (vpds_domain_fn)ramp; refused(&d, "desc.domain", VPDS_ERR_UNSUPPORTED);
     d = vpds_default_desc(); d.radius_min = -1; refused(&d, "desc.radius_min = -1", VPDS_ERR_INVALID_ARGUMENT);
     d = vpds_default_desc(); d.radius_max = NAN; refused(&d, "desc.radius_max = nan", VPDS_ERR_INVALID_ARGUMENT);
     d = vpds_default_desc(); d.radius_min = 2; d.radius_max = 1; refused(&d, "radius_min = 2 > desc.radius_max = 1", VPDS_ERR_INVALID_ARGUMENT);

@@ -1,0 +1,324 @@
+/* Domains, checked by brute force: every sample inside (sdf <= 0), no conflict in insertion
+ * order, and every probe of the domain covered — random probes inside and probes on the
+ * boundary itself — for an annulus, an L-shape and a polygon with a hole (uniform and
+ * variable radii, every rule, two radii, the stream), a mask drawn from a polygon, and a 3D
+ * ball and torus. Then each bad domain gives its clear error and changes nothing. */
+#include "check.h"
+#include "vpds.h"
+#include "rules.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int quick; /* VPDS_TEST_QUICK (valgrind): fewer configurations */
+
+typedef double (*fn_t)(const double *, void *);
+
+static double annulus(const double *x, void *u)
+{
+    double r = hypot(x[0] - 0.5, x[1] - 0.5);
+    (void)u;
+    return fmax(r - 0.45, 0.2 - r);
+}
+static double ball(const double *x, void *u)
+{
+    (void)u;
+    return sqrt((x[0] - 0.5) * (x[0] - 0.5) + (x[1] - 0.5) * (x[1] - 0.5) + (x[2] - 0.5) * (x[2] - 0.5)) - 0.4;
+}
+static double torus(const double *x, void *u)
+{
+    double q = hypot(x[0] - 0.5, x[1] - 0.5) - 0.3;
+    (void)u;
+    return hypot(q, x[2] - 0.5) - 0.12;
+}
+static double ramp(const double *x, void *u) { (void)u; return 0.02 + 0.03 * x[0]; }
+static double empty(const double *x, void *u) { (void)x; (void)u; return 1.0; }
+static double nan_far(const double *x, void *u) { (void)u; return x[0] > 0.7 ? NAN : x[0] - 0.9; }
+static double steep(const double *x, void *u) { (void)u; return 3 * (x[0] - 0.5); }
+
+typedef struct {
+    int dim;
+    vpds_rule rule;
+    double inhibition;
+    fn_t sdf;
+    void *user;
+    fn_t sizing;
+    double radius;
+} setup;
+
+static double dist(int d, const double *a, const double *b)
+{
+    double s = 0;
+    int k;
+    for (k = 0; k < d; k++) s += (a[k] - b[k]) * (a[k] - b[k]);
+    return sqrt(s);
+}
+
+/* Probes: random points of the box kept when inside, plus `extra` given points (boundary). */
+static void check_set(const setup *c, const double *x, const double *r, size_t n, double tau,
+                      double tol, const double *extra, size_t n_extra, const char *what)
+{
+    size_t i, j, p, outside = 0, conflicts = 0, gaps = 0, probes = 0;
+    int d = c->dim, k;
+    for (i = 0; i < n; i++) {
+        if (c->sdf(x + i * (size_t)d, c->user) > 0) outside++;
+        for (j = 0; j < i; j++)
+            if (dist(d, x + i * (size_t)d, x + j * (size_t)d) <
+                tau * c->inhibition * (1 - tol) * vpdsi_rule_f(c->rule, r[j], r[i]))
+                conflicts++;
+    }
+    srand(7);
+    for (p = 0; p < (quick ? 1500u : 4000u) + n_extra; p++) {
+        double y[3], ry, best = INFINITY;
+        if (p < n_extra) {
+            memcpy(y, extra + p * (size_t)d, (size_t)d * sizeof(double));
+        } else {
+            for (k = 0; k < d; k++) y[k] = rand() / (RAND_MAX + 1.0);
+            if (c->sdf(y, c->user) > 0) continue;
+        }
+        probes++;
+        ry = c->sizing ? c->sizing(y, NULL) : c->radius;
+        for (i = 0; i < n; i++) {
+            double e = dist(d, x + i * (size_t)d, y) / vpdsi_rule_f(c->rule, r[i], ry);
+            if (e < best) best = e;
+        }
+        if (best > tau * (1 + 1e-9)) gaps++;
+    }
+    CHECK_MSG(n > 0 && outside == 0 && conflicts == 0 && gaps == 0,
+              "%s (rule %d, inhibition %g): %zu samples, %zu outside, %zu conflicts, %zu of %zu probes"
+              " uncovered", what, (int)c->rule, c->inhibition, n, outside, conflicts, gaps, probes);
+}
+
+static vpds_sampler *make(const setup *c, uint64_t seed)
+{
+    vpds_desc d = vpds_default_desc();
+    vpds_sampler *s = NULL;
+    d.dim = c->dim;
+    d.rule = c->rule;
+    d.inhibition = c->inhibition;
+    d.radius = c->radius;
+    d.domain = c->sdf;
+    d.domain_user = c->user;
+    if (c->sizing) {
+        d.sizing = c->sizing;
+        d.lipschitz = 0.03;
+    }
+    d.seed = seed;
+    CHECK(vpds_create(&d, &s) == VPDS_OK);
+    return s;
+}
+
+static void check_run(const setup *c, const double *extra, size_t n_extra, const char *what)
+{
+    vpds_sampler *s = make(c, 5);
+    vpds_status st = vpds_run(s);
+    CHECK_MSG(st == VPDS_OK, "%s: %s", what, vpds_last_error(s));
+    check_set(c, vpds_points(s), vpds_radii(s), vpds_count(s), 1.0, 0, extra, n_extra, what);
+    vpds_destroy(s);
+}
+
+/* Stream prefixes at a few scales, each inside, conflict-free and covering the domain. */
+static void check_stream(const setup *c, size_t n, const double *extra, size_t n_extra, const char *what)
+{
+    vpds_sampler *s = make(c, 9);
+    double *ts = (double *)malloc(n * sizeof(double)), x[3];
+    size_t i, q;
+    for (i = 0; i < n; i++) CHECK(vpds_next(s, 0, x, ts + i) == VPDS_OK);
+    CHECK(isinf(ts[0]));
+    for (q = 1; q <= 3; q++) {
+        size_t m = n * q / 3 - 1;
+        double tau = ts[m];
+        while (m + 1 < n && ts[m + 1] == tau) m++;
+        check_set(c, vpds_points(s), vpds_radii(s), m + 1, tau, VPDS_STREAM_TOLERANCE, extra,
+                  n_extra, what);
+    }
+    free(ts);
+    vpds_destroy(s);
+}
+
+/* Points along the rings of a polygon (every edge, 20 per edge). */
+static size_t edge_probes(const double *xy, const size_t *sizes, size_t rings, double *out)
+{
+    size_t r, j, at = 0, m = 0;
+    int q;
+    for (r = 0; r < rings; at += sizes[r], r++)
+        for (j = 0; j < sizes[r]; j++) {
+            const double *a = xy + 2 * (at + j), *b = xy + 2 * (at + (j + 1) % sizes[r]);
+            for (q = 0; q < 20; q++, m++) {
+                out[2 * m] = a[0] + (b[0] - a[0]) * q / 20.0;
+                out[2 * m + 1] = a[1] + (b[1] - a[1]) * q / 20.0;
+            }
+        }
+    return m;
+}
+
+int main(void)
+{
+    static const vpds_rule rules[4] = {VPDS_RULE_PRIOR, VPDS_RULE_CURRENT, VPDS_RULE_BIGGER,
+                                       VPDS_RULE_SMALLER};
+    double circles[2 * 400], edges[2 * 400];
+    size_t n_circles = 0, n_edges, q;
+    int i;
+    setup c;
+    vpds_polygon *lshape, *holed;
+    vpds_polygon_desc pd;
+    /* an L-shape, and a square with a square hole (its ring reversed) */
+    static const double l_xy[] = {0.1, 0.1, 0.9, 0.1, 0.9, 0.4, 0.4, 0.4, 0.4, 0.9, 0.1, 0.9};
+    static const size_t l_sizes[] = {6};
+    static const double h_xy[] = {0.05, 0.05, 0.95, 0.05, 0.95, 0.95, 0.05, 0.95,
+                                  0.3, 0.3, 0.3, 0.7, 0.7, 0.7, 0.7, 0.3};
+    static const size_t h_sizes[] = {4, 4};
+    quick = getenv("VPDS_TEST_QUICK") != NULL;
+
+    for (i = 0; i < 200; i++) { /* both circles of the annulus */
+        double a = 2 * 3.14159265358979323846 * i / 200.0;
+        circles[2 * n_circles] = 0.5 + 0.45 * cos(a);
+        circles[2 * n_circles++ + 1] = 0.5 + 0.45 * sin(a);
+        circles[2 * n_circles] = 0.5 + 0.2 * cos(a);
+        circles[2 * n_circles++ + 1] = 0.5 + 0.2 * sin(a);
+    }
+    memset(&c, 0, sizeof c);
+    c.dim = 2;
+    c.inhibition = 1;
+    c.sdf = annulus;
+    c.radius = 0.03;
+    for (q = 0; q < 4; q++) {
+        c.rule = rules[q];
+        c.sizing = NULL;
+        check_run(&c, circles, n_circles, "annulus, uniform");
+        c.sizing = ramp;
+        check_run(&c, circles, n_circles, "annulus, ramp");
+        if (quick) break;
+    }
+    c.rule = VPDS_RULE_SMALLER;
+    c.sizing = NULL;
+    c.inhibition = 0.5;
+    check_run(&c, circles, n_circles, "annulus, two radii");
+    c.sizing = ramp;
+    check_stream(&c, quick ? 200 : 500, circles, n_circles, "annulus stream, two radii, ramp");
+    c.inhibition = 1;
+    c.sizing = NULL;
+    check_stream(&c, quick ? 200 : 500, circles, n_circles, "annulus stream");
+
+    /* polygons: the L-shape and the square with a hole */
+    pd = vpds_default_polygon_desc();
+    pd.xy = l_xy;
+    pd.ring_sizes = l_sizes;
+    pd.n_rings = 1;
+    CHECK(vpds_polygon_create(&pd, &lshape) == VPDS_OK);
+    pd.xy = h_xy;
+    pd.ring_sizes = h_sizes;
+    pd.n_rings = 2;
+    CHECK(vpds_polygon_create(&pd, &holed) == VPDS_OK);
+    {
+        double p_in[2] = {0.2, 0.2}, p_out[2] = {0.6, 0.6}, p_hole[2] = {0.5, 0.5};
+        CHECK(vpds_polygon_sdf(p_in, lshape) == -0.1 || fabs(vpds_polygon_sdf(p_in, lshape) + 0.1) < 1e-15);
+        CHECK(fabs(vpds_polygon_sdf(p_out, lshape) - 0.2) < 1e-15);
+        CHECK(fabs(vpds_polygon_sdf(p_hole, holed) - 0.2) < 1e-15);
+    }
+    c.sdf = vpds_polygon_sdf;
+    for (q = 0; q < 4; q++) {
+        c.rule = rules[q];
+        c.user = lshape;
+        n_edges = edge_probes(l_xy, l_sizes, 1, edges);
+        c.sizing = q % 2 ? ramp : NULL;
+        check_run(&c, edges, n_edges, "L-shape");
+        c.user = holed;
+        n_edges = edge_probes(h_xy, h_sizes, 2, edges);
+        c.sizing = q % 2 ? NULL : ramp;
+        check_run(&c, edges, n_edges, "square with a hole");
+        if (quick) break;
+    }
+
+    /* a mask drawn from the polygon with a hole gives a set with the same properties, for its
+     * own domain; and that domain is the polygon's up to a cell */
+    {
+        enum { M = 128 };
+        static double values[M * M];
+        size_t shape[2] = {M, M}, ii, jj, disagree = 0;
+        vpds_mask_desc md = vpds_default_mask_desc();
+        vpds_mask *mask;
+        for (ii = 0; ii < M; ii++)
+            for (jj = 0; jj < M; jj++) {
+                /* axis 0 (rows) is x[0]: cell (ii, jj) has its centre at ((ii+.5)/M, (jj+.5)/M) */
+                double p[2] = {(ii + 0.5) / M, (jj + 0.5) / M};
+                values[ii * M + jj] = vpds_polygon_sdf(p, holed) <= 0;
+            }
+        md.shape = shape;
+        md.values = values;
+        CHECK(vpds_mask_create(&md, &mask) == VPDS_OK);
+        for (ii = 0; ii < 4000; ii++) {
+            double p[2] = {rand() / (RAND_MAX + 1.0), rand() / (RAND_MAX + 1.0)};
+            double a = vpds_polygon_sdf(p, holed), b = vpds_mask_sdf(p, mask);
+            if ((a <= 0) != (b <= 0) && fabs(a) > 1.0 / M) disagree++;
+        }
+        CHECK_MSG(disagree == 0, "mask and polygon disagree at %zu points farther than a cell from the boundary",
+                  disagree);
+        c.sdf = vpds_mask_sdf;
+        c.user = mask;
+        c.sizing = NULL;
+        c.rule = VPDS_RULE_SMALLER;
+        check_run(&c, NULL, 0, "mask of the square with a hole");
+        vpds_mask_destroy(mask);
+    }
+    vpds_polygon_destroy(lshape);
+    vpds_polygon_destroy(holed);
+
+    /* 3D: a ball and a torus */
+    c.dim = 3;
+    c.user = NULL;
+    c.sizing = NULL;
+    c.radius = 0.08;
+    c.sdf = ball;
+    check_run(&c, NULL, 0, "ball");
+    c.sdf = torus;
+    c.radius = 0.06;
+    check_run(&c, NULL, 0, "torus");
+    if (!quick) check_stream(&c, 400, NULL, 0, "torus stream");
+
+    /* bad domains: each a clear error, nothing changed */
+    {
+        vpds_sampler *s;
+        vpds_desc d = vpds_default_desc();
+        double x[2], t;
+        char msg[512];
+        d.domain = empty;
+        CHECK(vpds_create(&d, &s) == VPDS_OK);
+        CHECK(vpds_run(s) == VPDS_ERR_DOMAIN && vpds_count(s) == 0 && strstr(vpds_last_error(s), "empty"));
+        CHECK(vpds_run(s) == VPDS_ERR_DOMAIN && !vpds_get_stats(s).maximal);
+        CHECK(vpds_next(s, 0, x, &t) == VPDS_ERR_DOMAIN && vpds_count(s) == 0);
+        vpds_destroy(s);
+        d.domain = nan_far;
+        CHECK(vpds_create(&d, &s) == VPDS_OK);
+        CHECK(vpds_run(s) == VPDS_ERR_DOMAIN && strstr(vpds_last_error(s), "NaN"));
+        vpds_destroy(s);
+        d.domain = steep;
+        CHECK(vpds_create(&d, &s) == VPDS_OK);
+        CHECK_MSG(vpds_run(s) == VPDS_ERR_DOMAIN && strstr(vpds_last_error(s), "1-Lipschitz"),
+                  "steep domain: %s", vpds_last_error(s));
+        vpds_destroy(s);
+        {
+            /* a bow tie crosses itself; a mask with no inside cell */
+            static const double bow[] = {0, 0, 1, 1, 1, 0, 0, 1};
+            static const size_t four[] = {4};
+            static const double zeros[4] = {0, 0, 0, 0.2};
+            size_t shape[2] = {2, 2};
+            vpds_polygon *p = (vpds_polygon *)&msg;
+            vpds_mask *m = (vpds_mask *)&msg;
+            vpds_mask_desc md = vpds_default_mask_desc();
+            pd = vpds_default_polygon_desc();
+            pd.xy = bow;
+            pd.ring_sizes = four;
+            pd.n_rings = 1;
+            CHECK(vpds_polygon_validate(&pd, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT &&
+                  strstr(msg, "intersects itself"));
+            CHECK(vpds_polygon_create(&pd, &p) == VPDS_ERR_INVALID_ARGUMENT && p == NULL);
+            md.shape = shape;
+            md.values = zeros;
+            CHECK(vpds_mask_validate(&md, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT &&
+                  strstr(msg, "no value"));
+            CHECK(vpds_mask_create(&md, &m) == VPDS_ERR_INVALID_ARGUMENT && m == NULL);
+        }
+    }
+    CHECK_DONE();
+}
