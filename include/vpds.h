@@ -48,6 +48,9 @@ extern "C" {
  * there is within t * (1 - eps) * inhibition * f of them at worst (exact with two radii when
  * inhibition <= coverage * (1 - eps)). */
 #define VPDS_STREAM_TOLERANCE 1e-5
+/* The same with a domain (desc.domain set): on a curved boundary the maximum of the gap is flat
+ * along the boundary, and a tolerance eps costs about 1/eps search boxes per sample there. */
+#define VPDS_STREAM_DOMAIN_TOLERANCE 1e-3
 /* Value of vpds_desc.lipschitz meaning "not given". */
 #define VPDS_UNSET (-1.0)
 

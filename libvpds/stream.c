@@ -215,7 +215,9 @@ static vpds_status eval_boxes(vpds_sampler *s, const double *centres, size_t n, 
 }
 
 /* Best-first search for the maximum of g over one region, to the tolerance: *bound is an upper
- * bound of g over the region and g(y) = *gy >= *bound / (1 + VPDS_STREAM_TOLERANCE). */
+ * bound of g over the region and g(y) = *gy >= *bound / (1 + tolerance). With a domain the
+ * tolerance is VPDS_STREAM_DOMAIN_TOLERANCE: on a curved boundary g is often maximal where it
+ * varies quadratically along the boundary, so a tolerance eps costs about 1/eps boxes there. */
 static vpds_status search_region(vpds_sampler *s, const double *centre, const double *half,
                                  double *bound, double *y, double *gy)
 {
@@ -223,6 +225,7 @@ static vpds_status search_region(vpds_sampler *s, const double *centre, const do
     int d = s->dim, k;
     size_t w = 1 + 2 * (size_t)d, children = (size_t)1 << d, j;
     double best = -1, extra = -1; /* extra: bounds of boxes no longer searched */
+    double tol = s->domain ? VPDS_STREAM_DOMAIN_TOLERANCE : VPDS_STREAM_TOLERANCE;
     double g1, ub1, cs[(1u << VPDS_MAX_DIM) * VPDS_MAX_DIM], gs[1u << VPDS_MAX_DIM],
         ubs[1u << VPDS_MAX_DIM], mag = 0;
     vpds_status e;
@@ -258,7 +261,7 @@ static vpds_status search_region(vpds_sampler *s, const double *centre, const do
             *gy = -1;
             return VPDS_OK;
         }
-        if (U <= best * (1 + VPDS_STREAM_TOLERANCE) || st->n_boxes == 0) {
+        if (U <= best * (1 + tol) || st->n_boxes == 0) {
             *bound = U;
             *gy = best;
             return VPDS_OK;
@@ -293,7 +296,7 @@ static vpds_status search_region(vpds_sampler *s, const double *centre, const do
         for (j = 0; j < children; j++) {
             double *r;
             if (ubs[j] < 0) continue; /* outside the domain */
-            if (ubs[j] <= best * (1 + VPDS_STREAM_TOLERANCE)) {
+            if (ubs[j] <= best * (1 + tol)) {
                 /* cannot beat the best by more than the tolerance: keep only its bound */
                 if (ubs[j] > extra) extra = ubs[j];
                 continue;
