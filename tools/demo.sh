@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 BUILD=${1:-build}
 mkdir -p out
 start=$(date +%s)
-python3 -m pip install -q --disable-pip-version-check numpy cffi matplotlib tqdm OpenEXR
+python3 -m pip install -q --disable-pip-version-check numpy cffi matplotlib tqdm OpenEXR Pillow
 python3 -m pip install -q --disable-pip-version-check ./bindings/python
 echo "== the C example: $BUILD/demo/figure1 (r = 0.001 + 0.3x, each rule)"
 "$BUILD/demo/figure1" out
@@ -35,4 +35,18 @@ OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineim
 PY
 python3 -m vpds sample --sizing-exr out/sizing.exr --exr-range 0.003,0.03 --lipschitz 0.3 \
   --seed 1 -o out/image.npz --plot out/image.png --no-progress
-echo "demo: wrote out/figure1_<rule>.csv and .png, out/figure10_quarter.npz and .png, out/image.npz and .png in $(( $(date +%s) - start )) s"
+echo "== a shaped domain: a star with a round hole painted in out/shape.png, maximal up to its edge"
+python3 - <<'PY'
+import math
+from PIL import Image, ImageDraw
+im = Image.new("L", (512, 512), 0)
+draw = ImageDraw.Draw(im)
+star = [(256 + (230 if k % 2 == 0 else 100) * math.sin(k * math.pi / 5),
+         256 - (230 if k % 2 == 0 else 100) * math.cos(k * math.pi / 5)) for k in range(10)]
+draw.polygon(star, fill=255)
+draw.ellipse((206, 206, 306, 306), fill=0)
+im.save("out/shape.png")
+PY
+python3 -m vpds sample --domain out/shape.png --sizing "0.004 + 0.012*x[1]" --lipschitz 0.012 \
+  --seed 3 -o out/domain.npz --plot out/domain.png --no-progress
+echo "demo: wrote out/figure1_<rule>.csv and .png, out/figure10_quarter.npz and .png, out/image.npz and .png, out/domain.npz and .png in $(( $(date +%s) - start )) s"

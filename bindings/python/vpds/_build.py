@@ -28,9 +28,12 @@ ffibuilder = FFI()
 ffibuilder.cdef(declarations_from_header(ROOT / "include" / "vpds.h"))
 # floating-point macros of vpds.h (cffi reads only integer #defines by itself)
 ffibuilder.cdef("static const double VPDS_STREAM_TOLERANCE;")
+ffibuilder.cdef("static const double VPDS_STREAM_DOMAIN_TOLERANCE;")
 # the batched sizing callback that runs Python code (see vpds._core.vpds_py_sizing_batch)
 ffibuilder.cdef('''extern "Python" int vpds_py_sizing_batch(const double *x, size_t n, double *r_out,
                                                       void *user);''')
+# the domain callback that runs Python code (see vpds.domain.vpds_py_domain)
+ffibuilder.cdef('extern "Python" double vpds_py_domain(const double *x, void *user);')
 ffibuilder.set_source(
     "vpds._vpds",
     '#include "vpds.h"\n' + UNITY,

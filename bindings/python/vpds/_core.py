@@ -3,14 +3,16 @@ from __future__ import annotations
 
 import numbers
 import os
-from typing import Any, Callable, Iterator, Optional, Sequence, Union
+from typing import Any, Callable, Iterator, NamedTuple, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
 
 from ._vpds import ffi, lib
+from .domain import Domain, as_domain
 
-__all__ = ["PoissonDisk", "SizingGrid", "VpdsError", "VpdsSizingError", "RULES"]
+__all__ = ["PoissonDisk", "SizingGrid", "VpdsError", "VpdsSizingError", "VpdsDomainError",
+           "Progressive", "RULES"]
 
 RULES = {"prior": lib.VPDS_RULE_PRIOR, "current": lib.VPDS_RULE_CURRENT,
          "bigger": lib.VPDS_RULE_BIGGER, "smaller": lib.VPDS_RULE_SMALLER}
@@ -40,6 +42,10 @@ class VpdsUnsupportedError(VpdsError, NotImplementedError):
     """A capability this version of libvpds does not provide yet."""
 
 
+class VpdsDomainError(VpdsError, ValueError):
+    """The domain function returned NaN, is not 1-Lipschitz, or its domain is empty."""
+
+
 class VpdsStateError(VpdsError):
     """The call is not valid in the sampler's current state (e.g. refining to a larger t)."""
 
@@ -50,7 +56,8 @@ def _raise(status: int, message: str, cause: Optional[BaseException] = None) -> 
     cls = {lib.VPDS_ERR_INVALID_ARGUMENT: VpdsValueError, lib.VPDS_ERR_OVERFLOW: VpdsValueError,
            lib.VPDS_ERR_BAD_DESCRIPTOR: VpdsValueError, lib.VPDS_ERR_SIZING: VpdsSizingError,
            lib.VPDS_ERR_LIPSCHITZ: VpdsSizingError, lib.VPDS_ERR_UNSUPPORTED: VpdsUnsupportedError,
-           lib.VPDS_ERR_STATE: VpdsStateError}.get(status, VpdsError)
+           lib.VPDS_ERR_STATE: VpdsStateError,
+           lib.VPDS_ERR_DOMAIN: VpdsDomainError}.get(status, VpdsError)
     raise cls(status, message) from cause
 
 
@@ -122,6 +129,14 @@ class SizingGrid:
                          for p in pts])
 
 
+class Progressive(NamedTuple):
+    """The first n samples of the continuous stream: each prefix is conflict-free and maximal
+    at its own scale, so the n points are evenly spread at scale `t`."""
+    points: np.ndarray  # (n, d)
+    scales: np.ndarray  # (n,): the t of each sample, non-increasing (inf for the first)
+    t: float            # the scale reached: the set is maximal at t (the last sample's t)
+
+
 def _seed_from(rng: Any) -> int:
     """An int is the C seed itself (the same points as the C library); a Generator (or
     anything numpy.random.default_rng takes) gives a seed drawn from it."""
@@ -157,6 +172,11 @@ class PoissonDisk:
       rule:       "prior", "current", "bigger" or "smaller" (Table 1 of the paper).
       fixed_points, fixed_radii: objects already placed, (k, d) and (k,) (radii None: the
                   sizing decides); they come first in the output.
+      domain:     sample box ∩ {sdf <= 0} only, maximal up to its boundary: a callable sdf on
+                  (m, d) points (negative inside, 1-Lipschitz), a polygon (shapely, (m, 2)
+                  vertices, or a list of rings; holes by nesting), a boolean or float mask
+                  over the box (inside: value >= domain_threshold), or an image file (.exr,
+                  .png, ...). See vpds.domain.
       progress:   a tqdm bar during fill_space (if tqdm is installed).
     Results are numpy arrays of shape (n, d) (copies: they outlive the sampler).
     """
@@ -173,7 +193,8 @@ class PoissonDisk:
                  fixed_radii: Optional[npt.ArrayLike] = None, progress: bool = True,
                  seed: Optional[int] = None, sizing_channel: Optional[str] = None,
                  sizing_range: Optional[Sequence[float]] = None,
-                 sizing_grid_shape: Optional[Sequence[int]] = None):
+                 sizing_grid_shape: Optional[Sequence[int]] = None, domain: Any = None,
+                 domain_threshold: float = 0.5):
         if hypersphere not in ("volume", "surface"):
             raise ValueError(f"{hypersphere!r} is not a valid hypersphere sampling method. It "
                              "must be one of {'volume', 'surface'} (it has no effect here)")
@@ -251,6 +272,12 @@ class PoissonDisk:
             desc.radius_min = float(radius_min)
         if radius_max is not None:
             desc.radius_max = float(radius_max)
+        self._domain: Optional[Domain] = None
+        if domain is not None:
+            self._domain = as_domain(domain, self.d, self.l_bounds, self.u_bounds,
+                                     float(domain_threshold))
+            desc.domain = self._domain.fn_ptr
+            desc.domain_user = self._domain.user
         desc.seed = self._seed
         self._desc = desc
         msg = ffi.new("char[]", 1024)
@@ -286,6 +313,8 @@ class PoissonDisk:
     def _check(self, st: int) -> int:
         if st < 0:
             cause, self._callback_error = self._callback_error, None
+            if cause is None and self._domain is not None:
+                cause, self._domain.error = self._domain.error, None
             if isinstance(cause, KeyboardInterrupt):
                 raise cause
             _raise(st, ffi.string(lib.vpds_last_error(self._s)).decode(), cause)
@@ -364,6 +393,52 @@ class PoissonDisk:
             self.num_generated = int(lib.vpds_count(self._s))
             yield np.frombuffer(ffi.buffer(x, self.d * 8), dtype=np.float64).copy(), float(t[0])
 
+    def progressive(self, n: int, *, inhibition: Optional[float] = 0.5) -> Progressive:
+        """Exactly n points: the first n samples of the continuous stream from this sampler's
+        fixed points (a fresh stream with the same seed; this sampler is not changed). Each
+        prefix is maximal at its own scale, so any n gives an evenly spread set; `t` is the
+        scale reached. `inhibition` is R_f / R_c for this stream: with 1 (equal radii) the
+        stream is farthest-point insertion, deterministic after the first point (its second
+        point is a corner of the box); the default 0.5 draws each point at random among those
+        free at t * R_f that cover the farthest point, as in the paper's Figure 7 (Delaunay
+        angles >= 14.48 deg). None keeps the sampler's own inhibition."""
+        n = int(n)
+        if n < 0:
+            raise ValueError(f"n = {n}: must be >= 0")
+        desc = ffi.new("vpds_desc *", self._desc[0])
+        if inhibition is not None:
+            if not 0 < float(inhibition) <= 1:
+                raise ValueError(f"inhibition = {inhibition!r}: the ratio R_f / R_c must be in (0, 1]")
+            desc.inhibition = float(inhibition) * desc.coverage
+        out = ffi.new("vpds_sampler **")
+        st = lib.vpds_create(desc, out)
+        if st != lib.VPDS_OK:
+            msg = ffi.new("char[]", 1024)
+            lib.vpds_validate(desc, msg, 1024)
+            _raise(st, ffi.string(msg).decode())
+        s = ffi.gc(out[0], lib.vpds_destroy)
+        saved, self._s = self._s, s  # _check reads the error of the sampler in use
+        try:
+            if self._fixed is not None:
+                fx, fr = self._fixed
+                self._check(lib.vpds_add_points(s, ffi.cast("const double *", ffi.from_buffer(fx)),
+                                                ffi.NULL if fr is None else ffi.cast("const double *", ffi.from_buffer(fr)),
+                                                len(fx)))
+            first = int(lib.vpds_count(s))
+            x = ffi.new("double[]", self.d)
+            t = ffi.new("double *")
+            for _ in range(n):
+                if self._check(lib.vpds_next(s, 0.0, x, t)) == lib.VPDS_STREAM_END:
+                    break
+            count = int(lib.vpds_count(s))
+            pts = np.frombuffer(ffi.buffer(lib.vpds_points(s), count * self.d * 8),
+                                dtype=np.float64).reshape(count, self.d)[first:].copy()
+            scales = np.frombuffer(ffi.buffer(lib.vpds_scales(s), count * 8),
+                                   dtype=np.float64)[first:].copy()
+        finally:
+            self._s = saved
+        return Progressive(pts, scales, float(scales[-1]) if len(scales) else float("inf"))
+
     def __iter__(self) -> Iterator[tuple[np.ndarray, float]]:
         return self.stream()
 
@@ -412,7 +487,7 @@ class PoissonDisk:
         st = lib.vpds_get_stats(self._s)
         return {k: getattr(st, k) for k in ("darts", "accepted", "levels", "peak_active_cells",
                                              "bytes_held", "peak_bytes", "sizing_calls", "delta",
-                                             "t", "maximal")}
+                                             "t", "maximal", "domain_calls")}
 
     @property
     def lipschitz(self) -> float:

@@ -99,6 +99,22 @@ def plot_points(path: Path, x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np
     plt.close(fig)
 
 
+def domain_from_file(path: Path):
+    """--domain FILE: an image (.png, .exr, ...: a mask over the box), a .npy array (a mask
+    with one axis per dimension, or (m, 2) polygon vertices), or a .wkt polygon (shapely)."""
+    if not path.exists():
+        raise SystemExit(f"vpds sample: --domain {path}: no such file")
+    if path.suffix.lower() == ".npy":
+        return np.load(path)
+    if path.suffix.lower() == ".wkt":
+        try:
+            from shapely import wkt
+        except ImportError:
+            raise SystemExit("vpds sample: --domain .wkt needs shapely (pip install shapely)") from None
+        return wkt.loads(path.read_text())
+    return str(path)
+
+
 def cmd_sample(args: argparse.Namespace) -> int:
     dim = args.dim
     lo = _floats(args.lo, dim, 0.0, "--lo")
@@ -119,10 +135,17 @@ def cmd_sample(args: argparse.Namespace) -> int:
     if args.periodic:
         axes = {int(a) for a in args.periodic.split(",")} if args.periodic != "all" else set(range(dim))
         periodic = [k in axes for k in range(dim)]
-    engine = PoissonDisk(dim, radius=args.radius, rng=args.seed, l_bounds=lo, u_bounds=hi,
-                         sizing=sizing, lipschitz=args.lipschitz, rule=args.rule,
-                         inhibition=args.inhibition, coverage=args.coverage, periodic=periodic,
-                         progress=not args.no_progress)
+    domain = None
+    if args.domain:
+        domain = domain_from_file(Path(args.domain))
+    try:
+        engine = PoissonDisk(dim, radius=args.radius, rng=args.seed, l_bounds=lo, u_bounds=hi,
+                             sizing=sizing, lipschitz=args.lipschitz, rule=args.rule,
+                             inhibition=args.inhibition, coverage=args.coverage, periodic=periodic,
+                             progress=not args.no_progress, domain=domain,
+                             domain_threshold=args.domain_threshold)
+    except (ValueError, ImportError, OSError) as exc:
+        raise SystemExit(f"vpds sample: {exc}") from None
     t0 = time.perf_counter()
     if args.stream:
         for _ in zip(range(args.stream), engine.stream()):
@@ -289,6 +312,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--refine", help="comma-separated decreasing scales t1,t2,... after the fill")
     s.add_argument("--stream", type=int, help="take N samples of the continuous stream instead")
     s.add_argument("--periodic", help="periodic axes: comma-separated indices, or 'all'")
+    s.add_argument("--domain", help="sample only inside: an image mask (.png, .exr, ...), a .npy "
+                   "mask or (m, 2) polygon, or a .wkt polygon; maximal up to its boundary")
+    s.add_argument("--domain-threshold", type=float, default=0.5,
+                   help="image or float mask: inside where value >= this (default 0.5)")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("-o", "--output", help="write the samples: .npy, .npz, .csv or .ply")
     s.add_argument("--plot", help="write a PNG of the samples (with their disks for small n)")
