@@ -1,12 +1,13 @@
 #define _POSIX_C_SOURCE 199309L
 /* libvpds workloads for `make bench`. Prints "name n seconds peak_bytes" per line.
  * usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION | ramp RULE | floor N DIM
- *        | stream DIM RADIUS N STEPS (prints one line per N/STEPS samples: the cost along n) */
+ *        | annulus RADIUS (a domain) | stream DIM RADIUS N STEPS (prints one line per N/STEPS samples: the cost along n) */
 #include "rng.h"
 #include "vpds.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <math.h>
 #include <time.h>
 
 static double now(void)
@@ -17,6 +18,13 @@ static double now(void)
 }
 
 static double ramp(const double *x, void *u) { (void)u; return 0.001 + 0.3 * x[0]; }
+/* the annulus 0.2 <= |x - (0.5, 0.5)| <= 0.45 as a signed distance */
+static double annulus(const double *x, void *u)
+{
+    double r = sqrt((x[0] - 0.5) * (x[0] - 0.5) + (x[1] - 0.5) * (x[1] - 0.5));
+    (void)u;
+    return r - 0.45 > 0.2 - r ? r - 0.45 : 0.2 - r;
+}
 
 static int run(const char *name, vpds_desc *d)
 {
@@ -77,6 +85,11 @@ int main(int argc, char **argv)
         d.radius = atof(argv[3]);
         d.inhibition = atof(argv[4]);
         return run("tworadii", &d);
+    }
+    if (argc >= 3 && !strcmp(argv[1], "annulus")) {
+        d.radius = atof(argv[2]);
+        d.domain = annulus;
+        return run("annulus", &d);
     }
     if (argc >= 6 && !strcmp(argv[1], "stream")) {
         d.dim = atoi(argv[2]);
