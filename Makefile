@@ -23,7 +23,7 @@ FLANN_TEST := $(BUILD)/tests/flann_kdtree
 SAMPLE_TOOL := $(BUILD)/tests/sample_tool
 SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 
-FUZZERS := run grid sequence sizing
+FUZZERS := run grid sequence sizing domain
 FUZZ_SECONDS ?= 120
 FUZZ_TEST_SECONDS ?= 30
 FUZZ_FLAGS := -g -O1 -std=c99 -Iinclude -ffp-contract=off -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all

@@ -62,7 +62,7 @@ static double rule_f(vpds_rule rule, double rx, double ry)
 /* Every status is one the API documents. */
 static void check_status(vpds_status st)
 {
-    FUZZ_ASSERT(st >= VPDS_ERR_OVERFLOW && st <= VPDS_STREAM_END, "status %d", (int)st);
+    FUZZ_ASSERT(st >= VPDS_ERR_DOMAIN && st <= VPDS_STREAM_END, "status %d", (int)st);
     FUZZ_ASSERT(strncmp(vpds_status_string(st), "VPDS_", 5) == 0, "status %d has no name", (int)st);
 }
 

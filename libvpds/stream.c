@@ -15,6 +15,7 @@
 #include <string.h>
 
 #define STREAM_FIRST_TRIES 1000000 /* uniform draws for a first sample inside the domain */
+#define STREAM_SEARCH_BUDGET 200000 /* box splits per search before VPDS_ERR_DOMAIN */
 #define STREAM_SPLIT 1.0 /* a region splits while its half-diagonal exceeds STREAM_SPLIT * t * coverage * r */
 
 void vpdsi_stream_init(vpdsi_stream *st)
@@ -226,6 +227,7 @@ static vpds_status search_region(vpds_sampler *s, const double *centre, const do
     size_t w = 1 + 2 * (size_t)d, children = (size_t)1 << d, j;
     double best = -1, extra = -1; /* extra: bounds of boxes no longer searched */
     double tol = s->domain ? VPDS_STREAM_DOMAIN_TOLERANCE : VPDS_STREAM_TOLERANCE;
+    long splits;
     double g1, ub1, cs[(1u << VPDS_MAX_DIM) * VPDS_MAX_DIM], gs[1u << VPDS_MAX_DIM],
         ubs[1u << VPDS_MAX_DIM], mag = 0;
     vpds_status e;
@@ -243,9 +245,19 @@ static vpds_status search_region(vpds_sampler *s, const double *centre, const do
     memcpy(st->boxes + 1, centre, (size_t)d * sizeof(double));
     memcpy(st->boxes + 1 + d, half, (size_t)d * sizeof(double));
     st->n_boxes = 1;
-    for (;;) {
+    for (splits = 0;; splits++) {
         double top = -1, hb[VPDS_MAX_DIM], cb[VPDS_MAX_DIM], hmax = 0, U;
         size_t at = 0;
+        if (splits == STREAM_SEARCH_BUDGET) {
+            /* never seen without a domain; a domain whose boundary the 1-Lipschitz bound cannot
+             * resolve (a sliver the box centres miss) would otherwise keep the search going */
+            char pc[256];
+            vpdsi_format_point(pc, sizeof pc, centre, d);
+            vpdsi_set_error(s, "vpds_next: the search for the farthest point near (%s) did not "
+                            "converge in %d box splits (a domain too thin for its signed distance"
+                            " to resolve?)", pc, STREAM_SEARCH_BUDGET);
+            return VPDS_ERR_DOMAIN;
+        }
         /* the open boxes form a small list; a linear scan finds the best (they are few) */
         for (j = 0; j < st->n_boxes; j++)
             if (st->boxes[j * w] > top) {
@@ -276,8 +288,12 @@ static vpds_status search_region(vpds_sampler *s, const double *centre, const do
             if (hb[k] > hmax) hmax = hb[k];
         }
         if (!(hmax > ldexp(mag, -46))) {
-            /* at the precision of doubles: keep its bound, search no deeper */
-            if (top > extra) extra = top;
+            /* at the precision of doubles: keep its bound, search no deeper; unless its centre
+             * lies outside the domain: then what it holds of the domain is within the
+             * precision of the boundary, covered up to it (as the box's delta) */
+            double phi = 0;
+            if (s->domain && (e = vpdsi_domain_at(s, cb, &phi)) != VPDS_OK) return e;
+            if (phi <= 0 && top > extra) extra = top;
             continue;
         }
         for (j = 0; j < children; j++)
