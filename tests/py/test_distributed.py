@@ -105,7 +105,7 @@ def test_refused_tilings_name_the_argument(tmp_path):
 @pytest.fixture(scope="module")
 def cluster():
     from distributed import Client, LocalCluster
-    c = LocalCluster(n_workers=4, threads_per_worker=1, processes=True, dashboard_address=None)
+    c = LocalCluster(n_workers=4, threads_per_worker=1, processes=True, dashboard_address=":0")
     client = Client(c)
     yield c, client
     client.close()
@@ -241,3 +241,19 @@ def test_seam_profile_differs_from_one_run_but_not_away_from_it():
         return stats.chi2_contingency(np.vstack([a, b]))[1]
     assert p_value(0.5) < 1e-12
     assert p_value(0.25) > 1e-3
+
+
+def test_cli_tiles(tmp_path, cluster, capsys):
+    from vpds.cli import main
+    _, client = cluster
+    out = tmp_path / "cli.zarr"
+    argv = ["sample", "--tiles", "3,2", "--hi", "1,0.8", "--radius", "0.03", "--seed", "4",
+            "-o", str(out), "--address", client.scheduler.address, "--no-progress"]
+    assert main(argv) == 0
+    assert "samples in 2D over 6 tiles (3, 2)" in capsys.readouterr().out
+    ref = D.run_local(tmp_path / "ref.zarr", TilingSpec.make(2, (3, 2), u_bounds=(1, 0.8), radius=0.03, rng=4))
+    assert all_bytes(D.TileStore(out)) == all_bytes(ref)
+    assert main(argv[:-3] + ["--address", client.scheduler.address, "--seed", "5"]) == 2
+    assert "holds another run (different seed)" in capsys.readouterr().err
+    with pytest.raises(SystemExit, match="needs --radius-max"):
+        main(["sample", "--tiles", "2", "--sizing", "0.02 + 0*x[0]", "--lipschitz", "0.1", "-o", str(tmp_path / "x.zarr")])

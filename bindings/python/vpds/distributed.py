@@ -29,6 +29,7 @@ __all__ = ["sample", "run_local", "GridSource", "TileStore", "TilingSpec", "Tili
 
 # per worker process: the C tiling of each run, built once (a run is identified by its token)
 _TILINGS: dict[str, Tiling] = {}
+_STORES: dict[str, TileStore] = {}  # per worker process: the open store of each path
 
 
 def _tiling_for(spec: TilingSpec) -> Tiling:
@@ -43,14 +44,13 @@ def _tiling_for(spec: TilingSpec) -> Tiling:
 def run_tile(spec: TilingSpec, path: str, tile: int, *done: Any) -> int:
     """One tile: read its dependencies from the store, run it, write it, mark it complete.
     Idempotent: a tile already complete is left as it is (a retried or resumed task)."""
-    store = TileStore(path, mode="r+")
+    store = _STORES.get(path)
+    if store is None:
+        store = _STORES[path] = TileStore(path, mode="r+")
     if store.complete(tile):
         return store.tile_count(tile)
     tiling = _tiling_for(spec)
-    deps = {}
-    for k in tiling.deps(tile):
-        x, r, _ = store.read(k)
-        deps[k] = (x, r)
+    deps = {k: store.read_points(k) for k in tiling.deps(tile)}
     x, r, t = tiling.run_tile(tile, deps)
     store.write(tile, x, r, t)
     return len(x)
@@ -60,6 +60,7 @@ def _open_store(store: Union[str, Path], spec: TilingSpec, tiling: Tiling, overw
     path = Path(store)
     if overwrite and path.exists():
         shutil.rmtree(path)
+    _STORES.pop(str(store), None)
     return TileStore.create(path, spec.describe(), spec.token,
                             [tiling.phase(k) for k in range(tiling.count)])
 
@@ -109,7 +110,7 @@ def sample(store: Union[str, Path], d: int, tiles: Union[int, Sequence[int]], *,
             client = Client(address)
         else:
             own_cluster = LocalCluster(n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1,
-                                       processes=True, dashboard_address=None)
+                                       processes=True, dashboard_address=":0")
             client = Client(own_cluster)
     own_client = own_cluster is not None or address is not None
     bar = None

@@ -96,6 +96,12 @@ class TileStore:
         g = self._group(tile)
         return g["points"][...], g["radius"][...], g["t"][...]
 
+    def read_points(self, tile: int) -> tuple[np.ndarray, np.ndarray]:
+        """(points, radius) of a complete tile: what a dependent tile's run needs."""
+        if not self.complete(tile):
+            raise KeyError(f"tile {tile} of {self.path} is not complete")
+        return self._root[f"tiles/{int(tile)}/points"][...], self._root[f"tiles/{int(tile)}/radius"][...]
+
     def tile_count(self, tile: int) -> int:
         return int(self._group(tile).attrs["count"])
 
