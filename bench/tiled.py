@@ -7,8 +7,8 @@ same box in this process (vpds.PoissonDisk) as the reference.
     python bench/tiled.py --largest 100000000 --tiles 64   # one big run to disk
 
 Wall clock, one run per row; the cluster is started before the clock (its start-up, about
-2 s, is reported apart). Peak memory per worker is the largest ru_maxrss of the worker
-processes (fresh processes for every row)."""
+2 s, is reported apart). Peak memory per worker is the largest high-water mark of the worker
+processes (VmHWM; fresh processes for every row)."""
 from __future__ import annotations
 
 import argparse
@@ -23,6 +23,15 @@ import numpy as np
 
 
 def peak_rss_mb() -> float:
+    """This process's peak resident memory (VmHWM: unlike ru_maxrss, it does not inherit the
+    parent's peak across the fork and exec that start a worker)."""
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024.0
+    except OSError:
+        pass
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
