@@ -142,8 +142,22 @@ def test_one_two_four_workers_and_two_orders_same_bytes(tmp_path, cluster):
     client.wait_for_workers(4)
 
 
-def test_killed_worker_and_interrupt_then_resume(tmp_path, cluster):
-    c, client = cluster
+@pytest.fixture
+def own_cluster():
+    """A cluster of its own for the test that kills a worker: the shared one stays clean."""
+    from distributed import Client, LocalCluster
+    c = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0")
+    client = Client(c)
+    yield c, client
+    client.close()
+    try:
+        c.close()
+    except KeyError:  # dask's bookkeeping of the worker we killed (its old address), not ours
+        pass
+
+
+def test_killed_worker_and_interrupt_then_resume(tmp_path, own_cluster):
+    c, client = own_cluster
     args = dict(ARGS, sizing=None, radius=0.004, rule="smaller")
     args.pop("lipschitz"), args.pop("radius_max")
     ref = all_bytes(D.run_local(tmp_path / "ref.zarr", TilingSpec.make(2, (6, 6), **args)))
