@@ -133,6 +133,7 @@ $(BUILD)/bench/bench: bench/bench.c $(STATIC)
 # Speed and memory beside the peers (installed by the script itself); BENCH_ARGS=--quick for a short run.
 bench: $(BUILD)/bench/bench
 	python3 bench/run.py $(BENCH_ARGS)
+	python3 bench/tiled.py $(if $(findstring --quick,$(BENCH_ARGS)),--quick)
 
 deps:
 	bash tools/deps.sh
@@ -149,3 +150,9 @@ install: all
 
 clean:
 	rm -rf $(BUILD)
+
+# ---- Tiled sampling on Dask (vpds.distributed): samples/s for 1 and 2 workers, scaling with tiles,
+# peak memory per worker (also the last step of `make bench`); BENCH_ARGS=--quick for a short run.
+.PHONY: bench-tiled
+bench-tiled:
+	python3 bench/tiled.py $(BENCH_ARGS)

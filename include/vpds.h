@@ -283,6 +283,97 @@ VPDS_API vpds_status vpds_mask_create(const vpds_mask_desc *desc, vpds_mask **ou
 VPDS_API void vpds_mask_destroy(vpds_mask *mask);
 VPDS_API double vpds_mask_sdf(const double *x, void *mask);
 
+/* ---- Grid windows: a grid too large to hold, read one part at a time (tiled sampling). */
+/* desc->shape and desc->values describe nodes [offset[k], offset[k] + shape[k]) of a grid of
+ * whole_shape[k] nodes per axis over [desc->lo, desc->hi] (the whole grid's box). Inside the
+ * cells it holds, the window evaluates bit for bit as the whole grid; elsewhere vpds_grid_eval
+ * gives NaN and a sampler using it stops with VPDS_ERR_SIZING. Its Lipschitz constant, min and
+ * max are the window's own; vpds_grid_enforce_lipschitz refuses a window (VPDS_ERR_UNSUPPORTED). */
+VPDS_API vpds_status vpds_grid_validate_window(const vpds_grid_desc *desc, const size_t *whole_shape,
+                                               const size_t *offset, char *msg, size_t cap);
+VPDS_API vpds_status vpds_grid_create_window(const vpds_grid_desc *desc, const size_t *whole_shape,
+                                             const size_t *offset, vpds_grid **out);
+
+/* ---- Tiled sampling (libvpds/tiles.c): a box sampled as a grid of tiles, with the guarantees
+ * of one run across every seam. Tile k has integer coordinates c (C order: axis 0 slowest) and
+ * phase sum_k (c_k & 1) << k: 2^dim phases, and tiles of one phase never touch. A tile's run
+ * samples its core (its cell of the grid of tiles) with the seed vpds_tiling_seed(tile) and,
+ * as fixed points, the samples of its dependencies (the neighbouring tiles of lower phase,
+ * wrapping on periodic axes) that lie within the margin of the core: margin = scale * coverage *
+ * r_max, the farthest any conflict or coverage disk reaches. So every sample is checked against
+ * every earlier sample that could conflict with it, every point of a core is covered, and tiles
+ * of one phase (at least one tile side, >= margin, apart) cannot interact: the union of the
+ * cores is conflict-free in the order (phase, tile, insertion) and maximal, and it depends on
+ * the seed alone, never on the order in which tiles run. A tile of phase p needs its
+ * dependencies done first, and they theirs: vpds_tiling_cone lists that cone in an order that
+ * can run, so an engine can sample the tiles around a camera on demand and get the batch's
+ * points. Only a tile's own samples (not its fixed points) belong to it. */
+typedef struct vpds_tiling vpds_tiling;
+
+typedef struct vpds_tiling_desc {
+    uint32_t cookie;          /* set by vpds_default_tiling_desc; do not change */
+    uint32_t struct_size;
+    const vpds_desc *sampler; /* the whole box and problem (box, periodic, sizing, rule, radii,
+                                 seed, allocator, budget); read at create: lo, hi, periodic are
+                                 copied and a sizing_grid cloned, callbacks and their user
+                                 pointers must outlive the tiling */
+    const uint64_t *tiles;    /* dim tile counts (>= 1; even on a periodic axis) */
+    double scale;             /* the scale t of every tile's run (default 1) */
+    int sizing_per_tile;      /* non-zero: no sizing in `sampler`; each vpds_tile_create gets a
+                                 window of the grid (sampler->lipschitz and radius_max, the whole
+                                 grid's, are then required; radius_min too if weighted) */
+} vpds_tiling_desc;
+
+/* The samples of one dependency: its own samples, in their insertion order. */
+typedef struct vpds_tile_points {
+    uint64_t tile;
+    const double *x; /* n * dim */
+    const double *r; /* n radii (vpds_radii) */
+    size_t n;
+} vpds_tile_points;
+
+/* Most dependencies a tile can have: its 3^dim - 1 neighbours. */
+#define VPDS_TILING_MAX_DEPS 6560
+
+VPDS_API vpds_tiling_desc vpds_default_tiling_desc(void);
+/* Why a tiling is refused (field and value), into msg. Tiles thinner than the margin are
+ * refused: tiles of one phase would interact. */
+VPDS_API vpds_status vpds_tiling_validate(const vpds_tiling_desc *desc, char *msg, size_t cap);
+VPDS_API vpds_status vpds_tiling_create(const vpds_tiling_desc *desc, vpds_tiling **out);
+VPDS_API void vpds_tiling_destroy(vpds_tiling *tiling);
+/* Number of tiles (0 for a NULL tiling). */
+VPDS_API uint64_t vpds_tiling_count(const vpds_tiling *tiling);
+VPDS_API double vpds_tiling_margin(const vpds_tiling *tiling);
+/* Phase of a tile (0 .. 2^dim - 1), -1 for a tile out of range. */
+VPDS_API int vpds_tiling_phase(const vpds_tiling *tiling, uint64_t tile);
+/* The seed of a tile's run: a splitmix64 hash of the sampler's seed and the tile index. */
+VPDS_API uint64_t vpds_tiling_seed(const vpds_tiling *tiling, uint64_t tile);
+/* Integer coordinates of a tile, and back (coords wrap on periodic axes; out of range on
+ * another axis is VPDS_ERR_INVALID_ARGUMENT). */
+VPDS_API vpds_status vpds_tiling_coords(const vpds_tiling *tiling, uint64_t tile, uint64_t *coords);
+VPDS_API vpds_status vpds_tiling_index(const vpds_tiling *tiling, const int64_t *coords,
+                                       uint64_t *tile);
+/* The tile's core: dim doubles each. Neighbouring cores share their faces exactly. */
+VPDS_API vpds_status vpds_tiling_box(const vpds_tiling *tiling, uint64_t tile, double *lo, double *hi);
+/* The tiles whose samples this tile's run needs (neighbours of lower phase), ascending; at most
+ * VPDS_TILING_MAX_DEPS. With cap too small, *n is the count needed and VPDS_ERR_OVERFLOW. */
+VPDS_API vpds_status vpds_tiling_deps(const vpds_tiling *tiling, uint64_t tile, uint64_t *out,
+                                      size_t cap, size_t *n);
+/* Every tile this tile needs, directly or not, in an order that can run (by phase, then
+ * index); the tile itself is not listed. With cap too small, *n is the count needed and
+ * VPDS_ERR_OVERFLOW. */
+VPDS_API vpds_status vpds_tiling_cone(const vpds_tiling *tiling, uint64_t tile, uint64_t *out,
+                                      size_t cap, size_t *n);
+/* A sampler for one tile, ready for vpds_run (and budgets, pauses, vpds_last_error): its box is
+ * the core, its seed and scale the tile's, and its first *n_fixed samples are the fixed points
+ * taken from `deps` (one entry per tile of vpds_tiling_deps, any order); the samples after them
+ * are the tile's own. sizing_window: the tile's window of the grid when the tiling has
+ * sizing_per_tile (NULL otherwise); it must cover the core. msg (cap bytes) says why on error. */
+VPDS_API vpds_status vpds_tile_create(const vpds_tiling *tiling, uint64_t tile,
+                                      const vpds_tile_points *deps, size_t n_deps,
+                                      const vpds_grid *sizing_window, vpds_sampler **out,
+                                      size_t *n_fixed, char *msg, size_t cap);
+
 #ifdef __cplusplus
 }
 #endif

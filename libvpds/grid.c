@@ -130,6 +130,7 @@ vpds_status vpdsi_grid_build(const vpds_grid_desc *d, vpds_grid **out)
         g->lo[k] = d->lo ? d->lo[k] : 0.0;
         g->hi[k] = d->hi ? d->hi[k] : 1.0;
         g->step[k] = (g->hi[k] - g->lo[k]) / (double)(d->shape[k] - 1);
+        g->whole[k] = d->shape[k];
     }
     for (s = 1, k = (size_t)d->dim; k-- > 0;) {
         g->stride[k] = s;
@@ -202,12 +203,14 @@ double vpds_grid_eval(const vpds_grid *g, const double *x)
         double u = (x[k] - g->lo[k]) / g->step[k], fl;
         size_t i;
         if (!(u > 0)) u = 0; /* also maps NaN to the first node */
-        if (u > (double)(g->shape[k] - 1)) u = (double)(g->shape[k] - 1);
+        if (u > (double)(g->whole[k] - 1)) u = (double)(g->whole[k] - 1);
         fl = floor(u);
         i = (size_t)fl;
-        if (i > g->shape[k] - 2) i = g->shape[k] - 2;
+        if (i > g->whole[k] - 2) i = g->whole[k] - 2;
         frac[k] = u - (double)i;
-        base += i * g->stride[k];
+        /* a window answers only where it holds both nodes of the cell */
+        if (i < g->offset[k] || i + 1 >= g->offset[k] + g->shape[k]) return NAN;
+        base += (i - g->offset[k]) * g->stride[k];
     }
     corners = 1u << d;
     for (c = 0; c < corners; c++) {
@@ -257,6 +260,7 @@ vpds_status vpds_grid_enforce_lipschitz(vpds_grid *g, double L)
     int round;
     if (!g || g->magic != VPDSI_GRID_COOKIE) return VPDS_ERR_INVALID_ARGUMENT;
     if (!isfinite(L) || !(L > 0)) return VPDS_ERR_INVALID_ARGUMENT;
+    if (g->window) return VPDS_ERR_UNSUPPORTED; /* the envelope of a part is not a part of the envelope */
     /* v + c rounds: when slopes are tiny beside the values the result can exceed L by a few ulps
      * of the values, so aim a little lower until the promise holds exactly */
     for (round = 0; round < 8; round++) {
@@ -272,5 +276,50 @@ vpds_status vpds_grid_enforce_lipschitz(vpds_grid *g, double L)
         for (i = 0; i < g->n; i++) g->values[i] = g->vmin;
         grid_refresh(g);
     }
+    return VPDS_OK;
+}
+
+/* ---- Windows of a grid too large to hold (tiled sampling reads one per tile). */
+
+vpds_status vpds_grid_validate_window(const vpds_grid_desc *d, const size_t *whole,
+                                      const size_t *offset, char *msg, size_t cap)
+{
+    vpds_status st = vpds_grid_validate(d, msg, cap);
+    size_t k;
+    if (st != VPDS_OK) return st;
+    if (!whole) FAIL(VPDS_ERR_INVALID_ARGUMENT, "whole_shape is NULL");
+    if (!offset) FAIL(VPDS_ERR_INVALID_ARGUMENT, "offset is NULL");
+    for (k = 0; k < (size_t)d->dim; k++) {
+        double lo = d->lo ? d->lo[k] : 0.0, hi = d->hi ? d->hi[k] : 1.0;
+        if (whole[k] < 2)
+            FAIL(VPDS_ERR_INVALID_ARGUMENT, "whole_shape[%u] = %zu: need at least 2 nodes per axis",
+                 (unsigned)k, whole[k]);
+        if (offset[k] > whole[k] || d->shape[k] > whole[k] - offset[k])
+            FAIL(VPDS_ERR_INVALID_ARGUMENT, "offset[%u] = %zu + shape[%u] = %zu exceeds whole_shape[%u] "
+                 "= %zu: the window must lie inside the grid", (unsigned)k, offset[k], (unsigned)k,
+                 d->shape[k], (unsigned)k, whole[k]);
+        if (!((hi - lo) / (double)(whole[k] - 1) > 0))
+            FAIL(VPDS_ERR_INVALID_ARGUMENT, "axis %u: the node spacing (%g - %g) / %zu is not a "
+                 "positive finite number", (unsigned)k, hi, lo, whole[k] - 1);
+    }
+    return VPDS_OK;
+}
+
+vpds_status vpds_grid_create_window(const vpds_grid_desc *d, const size_t *whole,
+                                    const size_t *offset, vpds_grid **out)
+{
+    vpds_status st;
+    size_t k;
+    if (!out) return VPDS_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    if ((st = vpds_grid_validate_window(d, whole, offset, NULL, 0)) != VPDS_OK) return st;
+    if ((st = vpds_grid_create(d, out)) != VPDS_OK) return st;
+    for (k = 0; k < (size_t)d->dim; k++) {
+        (*out)->whole[k] = whole[k];
+        (*out)->offset[k] = offset[k];
+        (*out)->step[k] = ((*out)->hi[k] - (*out)->lo[k]) / (double)(whole[k] - 1);
+    }
+    (*out)->window = 1;
+    grid_refresh(*out); /* slopes with the whole grid's node spacing */
     return VPDS_OK;
 }

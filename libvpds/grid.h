@@ -12,6 +12,11 @@ struct vpds_grid {
     size_t stride[VPDS_MAX_DIM];
     size_t n;
     double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], step[VPDS_MAX_DIM];
+    /* a window (vpds_grid_create_window) holds nodes [offset, offset + shape) of a grid of
+     * `whole` nodes per axis; lo, hi and step are the whole grid's (offset 0, whole = shape
+     * for a plain grid), so a point evaluates bit for bit as in the whole grid */
+    size_t offset[VPDS_MAX_DIM], whole[VPDS_MAX_DIM];
+    int window;
     double *values;
     double lipschitz; /* exact, recomputed after every change */
     double vmin, vmax;

@@ -25,6 +25,16 @@ vpds_status vpdsi_sizing_eval(vpdsi_sizing *s, const double *x, size_t n, double
     case VPDSI_SIZING_GRID:
         for (i = 0; i < n; i++) out[i] = vpds_grid_eval(s->grid, x + i * (size_t)s->dim);
         s->calls += n;
+        for (i = 0; s->grid->window && i < n; i++) {
+            if (!(out[i] > 0)) { /* NaN: a window answers only inside the nodes it holds */
+                if (err && cap) {
+                    char pt[256];
+                    vpdsi_format_point(pt, cap < sizeof pt ? cap : sizeof pt, x + i * (size_t)s->dim, s->dim);
+                    snprintf(err, cap, "x = (%s) lies outside the sizing grid window", pt);
+                }
+                return VPDS_ERR_SIZING;
+            }
+        }
         return VPDS_OK;
     default:
         break;

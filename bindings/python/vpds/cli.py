@@ -321,6 +321,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--plot", help="write a PNG of the samples (with their disks for small n)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
     s.set_defaults(func=cmd_sample)
+    from .cli_tiles import add_tile_arguments  # the tiled form: vpds sample --tiles ... -o X.zarr
+    add_tile_arguments(s, cmd_sample)
     a = sub.add_parser("analyze", help="check a sampling's guarantees and plot its spectrum")
     a.add_argument("file", help=".npz, .npy, .csv or .ply (as `vpds sample -o` writes)")
     a.add_argument("--rule", choices=sorted(RULES), default="smaller")

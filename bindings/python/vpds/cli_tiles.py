@@ -1,0 +1,76 @@
+"""`vpds sample --tiles ...`: a tiled run on Dask into a Zarr store, with a progress bar over
+tiles (vpds.distributed). The other options of `vpds sample` keep their meaning."""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from typing import Callable
+
+import numpy as np
+
+
+def add_tile_arguments(s: argparse.ArgumentParser, plain: Callable[[argparse.Namespace], int]) -> None:
+    """The tiled form's options on the `sample` parser; runs `plain` when --tiles is absent."""
+    g = s.add_argument_group("tiled sampling (vpds.distributed, Dask, Zarr)")
+    g.add_argument("--tiles", help="tiles per axis: one count for every axis, or comma-separated; "
+                   "-o must then name a .zarr store (resumed if it holds the same run)")
+    g.add_argument("--workers", type=int, help="LocalCluster worker processes (default: the cores)")
+    g.add_argument("--address", help="a Dask scheduler's address instead of a LocalCluster")
+    g.add_argument("--radius-max", type=float, help="upper bound of r (required with --sizing "
+                   "and --tiles: it sets the margin)")
+    g.add_argument("--overwrite", action="store_true", help="replace the store instead of resuming")
+    s.set_defaults(func=lambda args: cmd_sample_tiles(args) if args.tiles else plain(args))
+
+
+def cmd_sample_tiles(args: argparse.Namespace) -> int:
+    from . import distributed
+    from .cli import _floats, sizing_from_expression
+    dim = args.dim
+    if not args.output or not args.output.rstrip("/").endswith(".zarr"):
+        raise SystemExit("vpds sample: --tiles writes a Zarr store: give -o NAME.zarr")
+    for flag in ("refine", "stream", "plot"):
+        if getattr(args, flag):
+            raise SystemExit(f"vpds sample: --{flag} is not available with --tiles")
+    counts = [int(v) for v in args.tiles.split(",")]
+    if len(counts) == 1:
+        counts = counts * dim
+    if len(counts) != dim:
+        raise SystemExit(f"vpds sample: --tiles has {len(counts)} counts for --dim {dim}")
+    lo = _floats(args.lo, dim, 0.0, "--lo")
+    hi = _floats(args.hi, dim, 1.0, "--hi")
+    sizing = None
+    if args.sizing:
+        if args.radius_max is None:
+            raise SystemExit("vpds sample: --sizing with --tiles needs --radius-max (an upper bound "
+                             "of r: it sets the margin the tiles share)")
+        sizing = sizing_from_expression(args.sizing, dim)
+    elif args.sizing_exr:
+        if args.lipschitz is not None:
+            raise SystemExit("vpds sample: --lipschitz smooths an image in memory; with --tiles the "
+                             "image is read per tile: smooth it first, or run without --tiles")
+        exr_range = [float(v) for v in args.exr_range.split(",")] if args.exr_range else None
+        sizing = distributed.GridSource(args.sizing_exr, lo, hi, channel=args.channel,
+                                        radius_range=exr_range)
+    periodic = None
+    if args.periodic:
+        axes = {int(a) for a in args.periodic.split(",")} if args.periodic != "all" else set(range(dim))
+        periodic = [k in axes for k in range(dim)]
+    t0 = time.perf_counter()
+    try:
+        store = distributed.sample(args.output, dim, counts, l_bounds=lo, u_bounds=hi,
+                                   radius=args.radius, sizing=sizing, lipschitz=args.lipschitz,
+                                   radius_max=args.radius_max, rule=args.rule,
+                                   inhibition=args.inhibition, coverage=args.coverage,
+                                   periodic=periodic, rng=args.seed, address=args.address,
+                                   n_workers=args.workers, progress=not args.no_progress,
+                                   overwrite=args.overwrite)
+    except ValueError as exc:  # the C library's messages, and a store of another run
+        print(f"vpds sample: {exc}", file=sys.stderr)
+        return 2
+    seconds = time.perf_counter() - t0
+    total = store.total
+    print(f"{total} samples in {dim}D over {int(np.prod(counts))} tiles {tuple(counts)} "
+          f"(rule {args.rule}, seed {args.seed}) in {seconds:.3f} s; all tiles complete")
+    print(f"wrote {args.output} (read it back with vpds.distributed.TileStore)")
+    return 0

@@ -1,0 +1,168 @@
+"""Past one machine: a large box sampled as a grid of tiles on Dask, written to Zarr.
+
+    >>> from vpds import distributed
+    >>> store = distributed.sample("big.zarr", 2, tiles=(64, 64), u_bounds=(100, 100),
+    ...                            radius=0.01, rng=1)          # a LocalCluster, no set-up
+    >>> for tile, x, r, t in store.iter_tiles(): ...          # streams back, one tile at a time
+
+Each tile is one libvpds run over its core, with the samples its earlier-phase neighbours
+placed within the margin (scale * coverage * r_max) as fixed points and a seed derived from the
+global seed and the tile index (the C library's vpds_tiling / vpds_tile_create). Tiles of one of
+the 2^d colour phases never touch; Dask runs a tile as soon as its own dependencies are written,
+so the result depends on the seed alone, never on the number of workers or the order in which
+tasks finish. What holds across seams, and why: see the README ("Tiled sampling")."""
+from __future__ import annotations
+
+import os
+import shutil
+import uuid
+from pathlib import Path
+from typing import Any, Callable, Iterable, Optional, Sequence, Union
+
+import numpy as np
+
+from .gridsource import GridSource
+from .tilestore import TileStore
+from .tiling import SizingArg, Tiling, TilingSpec
+
+__all__ = ["sample", "run_local", "GridSource", "TileStore", "TilingSpec", "Tiling"]
+
+# per worker process: the C tiling of each run, built once (a run is identified by its token)
+_TILINGS: dict[str, Tiling] = {}
+_STORES: dict[str, TileStore] = {}  # per worker process: the open store of each path
+
+
+def _tiling_for(spec: TilingSpec) -> Tiling:
+    t = _TILINGS.get(spec.token)
+    if t is None:
+        if len(_TILINGS) > 8:
+            _TILINGS.clear()
+        t = _TILINGS[spec.token] = Tiling(spec)
+    return t
+
+
+def run_tile(spec: TilingSpec, path: str, tile: int, *done: Any) -> int:
+    """One tile: read its dependencies from the store, run it, write it, mark it complete.
+    Idempotent: a tile already complete is left as it is (a retried or resumed task)."""
+    store = _STORES.get(path)
+    if store is None:
+        store = _STORES[path] = TileStore(path, mode="r+")
+    if store.complete(tile):
+        return store.tile_count(tile)
+    tiling = _tiling_for(spec)
+    deps = {k: store.read_points(k) for k in tiling.deps(tile)}
+    x, r, t = tiling.run_tile(tile, deps)
+    store.write(tile, x, r, t)
+    return len(x)
+
+
+def _open_store(store: Union[str, Path], spec: TilingSpec, tiling: Tiling, overwrite: bool) -> TileStore:
+    path = Path(store)
+    if overwrite and path.exists():
+        shutil.rmtree(path)
+    _STORES.pop(str(store), None)
+    return TileStore.create(path, spec.describe(), spec.token,
+                            [tiling.phase(k) for k in range(tiling.count)])
+
+
+def _spec(d: int, tiles: Union[int, Sequence[int]], **kw: Any) -> TilingSpec:
+    if isinstance(kw.get("sizing"), (str, os.PathLike)):
+        kw["sizing"] = GridSource(kw["sizing"], kw.get("l_bounds") or [0.0] * d,
+                                  kw.get("u_bounds") or [1.0] * d)
+    return TilingSpec.make(d, tiles if not isinstance(tiles, int) else [tiles] * d, **kw)
+
+
+def sample(store: Union[str, Path], d: int, tiles: Union[int, Sequence[int]], *,
+           l_bounds: Optional[Sequence[float]] = None, u_bounds: Optional[Sequence[float]] = None,
+           radius: float = 0.05, sizing: Union[SizingArg, str] = None,
+           lipschitz: Optional[float] = None, rule: str = "smaller", inhibition: float = 1.0,
+           coverage: float = 1.0, periodic: Optional[Sequence[bool]] = None,
+           weighted: bool = False, radius_min: Optional[float] = None,
+           radius_max: Optional[float] = None, rng: Any = 0, scale: float = 1.0,
+           address: Optional[str] = None, client: Any = None, n_workers: Optional[int] = None,
+           progress: bool = True, overwrite: bool = False,
+           on_tile: Optional[Callable[[int, int], None]] = None) -> TileStore:
+    """Sample the box [l_bounds, u_bounds] as `tiles` tiles per axis into the Zarr store at
+    `store`, on Dask, and return the store (a reader that streams the tiles back).
+
+    The sampling arguments are PoissonDisk's (`sizing`: a float, a numpy grid in memory, a
+    `GridSource` or a path to a .npy / .zarr / .exr grid read one window per tile, or a
+    vectorised callable with `lipschitz` and `radius_max`). Scheduling: `client` (a
+    dask.distributed Client), else `address` (a scheduler's), else a LocalCluster of
+    `n_workers` processes (default: the cores) made for the call and closed after it. A store
+    that already holds some tiles of the same run is resumed: only the missing tiles run, and
+    the result is the bytes of a run that never stopped. `on_tile(tile, count)` is called as
+    each tile completes (after the progress bar's update)."""
+    spec = _spec(d, tiles, l_bounds=l_bounds, u_bounds=u_bounds, radius=radius, sizing=sizing,
+                 lipschitz=lipschitz, rule=rule, inhibition=inhibition, coverage=coverage,
+                 periodic=periodic, weighted=weighted, radius_min=radius_min,
+                 radius_max=radius_max, rng=rng, scale=scale)
+    tiling = Tiling(spec)
+    out = _open_store(store, spec, tiling, overwrite)
+    todo = out.missing()
+    if not todo:
+        return out
+    from distributed import Client, LocalCluster, as_completed
+
+    own_cluster = None
+    if client is None:
+        if address is not None:
+            client = Client(address)
+        else:
+            own_cluster = LocalCluster(n_workers=n_workers or os.cpu_count() or 1, threads_per_worker=1,
+                                       processes=True, dashboard_address=":0")
+            client = Client(own_cluster)
+    own_client = own_cluster is not None or address is not None
+    bar = None
+    futures: dict = {}
+    try:
+        if progress:
+            try:
+                from tqdm.auto import tqdm
+                bar = tqdm(total=tiling.count, initial=tiling.count - len(todo), unit=" tiles",
+                           desc="tiles")
+            except ImportError:
+                bar = None
+        spec_f = client.scatter(spec, broadcast=True, hash=False)
+        nonce = uuid.uuid4().hex[:8]
+        pending = set(todo)
+        for tile in tiling.order():
+            if tile not in pending:
+                continue
+            deps = [futures[k] for k in tiling.deps(tile) if k in futures]
+            futures[tile] = client.submit(run_tile, spec_f, str(store), tile, *deps,
+                                          key=f"vpds-tile-{spec.token[:8]}-{nonce}-{tile}", pure=False)
+        back = {f.key: k for k, f in futures.items()}
+        for fut in as_completed(list(futures.values())):
+            n = fut.result()  # raises the task's error (C message included)
+            if bar is not None:
+                bar.update(1)
+            if on_tile is not None:
+                on_tile(back[fut.key], n)
+    except BaseException:
+        for f in futures.values():
+            f.cancel()
+        raise
+    finally:
+        if bar is not None:
+            bar.close()
+        if own_client:
+            client.close()
+        if own_cluster is not None:
+            own_cluster.close()
+    return out
+
+
+def run_local(store: Union[str, Path], spec: TilingSpec, order: Optional[Iterable[int]] = None,
+              overwrite: bool = False) -> TileStore:
+    """The same run without Dask, in this process, tiles in `order` (default: by phase, then
+    index; any order in which each tile follows its dependencies gives the same bytes)."""
+    tiling = Tiling(spec)
+    out = _open_store(store, spec, tiling, overwrite)
+    _TILINGS[spec.token] = tiling
+    for tile in (tiling.order() if order is None else order):
+        missing = [k for k in tiling.deps(tile) if not out.complete(k)]
+        if missing:
+            raise ValueError(f"tile {tile} (phase {tiling.phase(tile)}) needs tiles {missing} first")
+        run_tile(spec, str(store), tile)
+    return out

@@ -1,0 +1,141 @@
+"""The Zarr store of a tiled run: one group per tile, written whole then marked complete.
+
+Layout (Zarr v3):
+    <root>/                 attrs["vpds_tiling"]: the run's parameters and their token
+    <root>/tiles/<k>/points (n, d) float64   the tile's own samples, in insertion order
+    <root>/tiles/<k>/radius (n,)   float64   r at each sample (unscaled)
+    <root>/tiles/<k>/t      (n,)   float64   the scale at which it was inserted
+    <root>/tiles/<k>        attrs {"count": n, "phase": p, "complete": true}, written last
+Tiles hold different counts, so each has its arrays. A tile whose group is not marked complete
+(a worker killed while writing it) is written again by a resumed run: every file is replaced
+atomically (Zarr's local store renames a finished temporary file), and a tile's bytes depend on
+the seed and its dependencies alone, so a rewrite gives the same bytes."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Iterator, Optional, Union
+
+import numpy as np
+
+__all__ = ["TileStore"]
+
+FORMAT = 1
+_ROWS_PER_CHUNK = 1 << 20
+
+
+class TileStore:
+    """Read and write the tiles of one run. `TileStore(path)` opens an existing store."""
+
+    def __init__(self, path: Union[str, Path], mode: str = "r"):
+        import zarr
+        self.path = str(path)
+        self._root = zarr.open_group(self.path, mode=mode)
+        info = self._root.attrs.get("vpds_tiling")
+        if info is None:
+            raise ValueError(f"{self.path}: not a vpds tile store (no vpds_tiling attribute)")
+        self.info = dict(info)
+        self.d = int(self.info["params"]["d"])
+        self.count = int(self.info["count"])
+        self.phases = list(self.info["phases"])
+
+    @classmethod
+    def create(cls, path: Union[str, Path], params: dict, token: str, phases: list) -> "TileStore":
+        """A new store, or the existing one when it holds the same run (same token)."""
+        import zarr
+        p = Path(path)
+        if (p / "zarr.json").exists():
+            store = cls(path, mode="r+")
+            if store.info.get("token") != token:
+                old = store.info.get("params", {})
+                diff = sorted(k for k in set(old) | set(params) if old.get(k) != params.get(k))
+                raise ValueError(f"{path} holds another run (different {', '.join(diff) or 'sizing'}); "
+                                 "resume needs the same parameters: use a new path or overwrite=True")
+            return store
+        root = zarr.open_group(str(path), mode="w")
+        root.create_group("tiles")
+        root.attrs["vpds_tiling"] = {"format": FORMAT, "token": token, "params": params,
+                                     "count": len(phases), "phases": [int(v) for v in phases]}
+        return cls(path, mode="r+")
+
+    # -- tiles -------------------------------------------------------------------------------------
+    def _group(self, tile: int):
+        try:
+            return self._root[f"tiles/{int(tile)}"]
+        except KeyError:
+            return None
+
+    def complete(self, tile: int) -> bool:
+        """Whether the tile is written whole. Reads its group's metadata file directly: cheap."""
+        meta = Path(self.path) / "tiles" / str(int(tile)) / "zarr.json"
+        try:
+            return bool(json.loads(meta.read_text()).get("attributes", {}).get("complete", False))
+        except (OSError, ValueError):
+            return False
+
+    def missing(self) -> list[int]:
+        return [k for k in range(self.count) if not self.complete(k)]
+
+    def write(self, tile: int, x: np.ndarray, r: np.ndarray, t: np.ndarray) -> None:
+        """The tile's arrays, then its completion mark (a reader never sees a partial tile)."""
+        g = self._root.require_group(f"tiles/{int(tile)}")
+        n = len(x)
+        for name, arr in (("points", np.ascontiguousarray(x, dtype=np.float64).reshape(n, self.d)),
+                          ("radius", np.ascontiguousarray(r, dtype=np.float64)),
+                          ("t", np.ascontiguousarray(t, dtype=np.float64))):
+            chunks = (max(1, min(n, _ROWS_PER_CHUNK)),) + arr.shape[1:]
+            a = g.create_array(name, shape=arr.shape, dtype="float64", chunks=chunks, overwrite=True)
+            if n:
+                a[...] = arr
+        g.attrs.update({"count": int(n), "phase": int(self.phases[int(tile)]), "complete": True})
+
+    def read(self, tile: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(points (n, d), radius (n,), t (n,)) of a complete tile."""
+        if not self.complete(tile):
+            raise KeyError(f"tile {tile} of {self.path} is not complete")
+        g = self._group(tile)
+        return g["points"][...], g["radius"][...], g["t"][...]
+
+    def read_points(self, tile: int) -> tuple[np.ndarray, np.ndarray]:
+        """(points, radius) of a complete tile: what a dependent tile's run needs."""
+        if not self.complete(tile):
+            raise KeyError(f"tile {tile} of {self.path} is not complete")
+        return self._root[f"tiles/{int(tile)}/points"][...], self._root[f"tiles/{int(tile)}/radius"][...]
+
+    def tile_count(self, tile: int) -> int:
+        return int(self._group(tile).attrs["count"])
+
+    # -- streaming back ----------------------------------------------------------------------------
+    def order(self) -> list[int]:
+        """The run's insertion order of tiles: by phase, then index."""
+        return sorted(range(self.count), key=lambda k: (self.phases[k], k))
+
+    def iter_tiles(self, order: str = "insertion") -> Iterator[tuple[int, np.ndarray, np.ndarray, np.ndarray]]:
+        """(tile, points, radius, t) one tile at a time: memory holds one tile, whatever the
+        total. order="insertion" (phase, then index: the order in which the union is
+        conflict-free under any rule) or "index"."""
+        tiles = self.order() if order == "insertion" else range(self.count)
+        for k in tiles:
+            x, r, t = self.read(k)
+            yield k, x, r, t
+
+    @property
+    def total(self) -> int:
+        """Samples in the complete tiles."""
+        return sum(self.tile_count(k) for k in range(self.count) if self.complete(k))
+
+    def to_numpy(self, order: str = "insertion") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Every sample at once (for runs that fit in memory)."""
+        parts = list(self.iter_tiles(order))
+        if not parts:
+            return np.empty((0, self.d)), np.empty(0), np.empty(0)
+        return (np.concatenate([p[1] for p in parts]), np.concatenate([p[2] for p in parts]),
+                np.concatenate([p[3] for p in parts]))
+
+    def __repr__(self) -> str:
+        done = self.count - len(self.missing())
+        return f"TileStore({self.path!r}: {done}/{self.count} tiles complete, d = {self.d})"
+
+    @property
+    def params(self) -> dict:
+        return dict(self.info["params"])

@@ -1,0 +1,324 @@
+"""The C tiling from Python: a box as a grid of tiles, and one tile's run (vpds_tile_create).
+
+A `TilingSpec` holds every parameter of a tiled run and pickles (it travels to Dask workers);
+`Tiling(spec)` builds the C object. Tile k's run samples its core with the seed derived from
+the global seed and k, and the samples of its earlier-phase neighbours within the margin as
+fixed points (see include/vpds.h, "Tiled sampling")."""
+from __future__ import annotations
+
+import hashlib
+import math
+import numbers
+from dataclasses import dataclass, field
+from typing import Any, Callable, Mapping, Optional, Sequence, Union
+
+import numpy as np
+
+from ._core import RULES, SizingGrid, _raise, _seed_from
+from ._vpds import ffi, lib
+from .gridsource import GridSource
+
+__all__ = ["TilingSpec", "Tiling"]
+
+SizingArg = Union[None, float, np.ndarray, SizingGrid, GridSource, Callable[[np.ndarray], np.ndarray]]
+
+
+@dataclass
+class TilingSpec:
+    """Everything that decides a tiled run's points (arrays of shape (d,) per axis).
+
+    sizing: None (use `radius`), a float, a grid of radii in memory (numpy array or
+    `SizingGrid`, multilinear over the box), a `GridSource` (a grid read one window per tile:
+    .npy, Zarr or OpenEXR), or a vectorised callable (then `lipschitz` and `radius_max`)."""
+
+    d: int
+    tiles: tuple
+    l_bounds: tuple
+    u_bounds: tuple
+    radius: float = 0.05
+    sizing: SizingArg = None
+    lipschitz: Optional[float] = None
+    rule: str = "smaller"
+    inhibition: float = 1.0
+    coverage: float = 1.0
+    periodic: Optional[tuple] = None
+    weighted: bool = False
+    radius_min: Optional[float] = None
+    radius_max: Optional[float] = None
+    seed: int = 0
+    scale: float = 1.0
+    _token: str = field(default="", repr=False)
+
+    @classmethod
+    def make(cls, d: int, tiles: Sequence[int], *, l_bounds: Optional[Sequence[float]] = None,
+             u_bounds: Optional[Sequence[float]] = None, radius: float = 0.05,
+             sizing: SizingArg = None, lipschitz: Optional[float] = None, rule: str = "smaller",
+             inhibition: float = 1.0, coverage: float = 1.0,
+             periodic: Optional[Sequence[bool]] = None, weighted: bool = False,
+             radius_min: Optional[float] = None, radius_max: Optional[float] = None,
+             rng: Any = 0, scale: float = 1.0) -> "TilingSpec":
+        """Checked arguments (the C library checks the rest, with its messages)."""
+        if not isinstance(d, (numbers.Integral, np.integer)) or isinstance(d, bool):
+            raise TypeError(f"d = {d!r}: must be an int")
+        d = int(d)
+        if rule not in RULES:
+            raise ValueError(f"rule = {rule!r}: must be one of {sorted(RULES)}")
+        tiles_t = tuple(int(v) for v in np.atleast_1d(tiles))
+        if len(tiles_t) == 1 and d > 1:
+            tiles_t = tiles_t * d
+        if len(tiles_t) != d:
+            raise ValueError(f"tiles = {tiles!r}: need 1 or {d} counts")
+        lo = tuple(float(v) for v in (np.zeros(d) if l_bounds is None else np.asarray(l_bounds, float).reshape(-1)))
+        hi = tuple(float(v) for v in (np.ones(d) if u_bounds is None else np.asarray(u_bounds, float).reshape(-1)))
+        if len(lo) != d or len(hi) != d:
+            raise ValueError(f"l_bounds and u_bounds must have {d} values each")
+        per = None if periodic is None else tuple(bool(p) for p in periodic)
+        if per is not None and len(per) != d:
+            raise ValueError(f"periodic has {len(per)} flags for {d} axes")
+        if sizing is not None and not callable(sizing) and np.ndim(sizing) == 0 and not isinstance(sizing, (SizingGrid, GridSource)):
+            radius, sizing = float(sizing), None
+        if isinstance(sizing, SizingGrid):
+            sizing = sizing.values
+        if isinstance(sizing, (np.ndarray, list, tuple)):
+            sizing = np.ascontiguousarray(sizing, dtype=np.float64)
+            if sizing.ndim != d:
+                raise ValueError(f"a sizing grid of {sizing.ndim} axes for d = {d}")
+        if isinstance(sizing, GridSource):
+            if sizing.dim != d:
+                raise ValueError(f"the sizing source has {sizing.dim} axes for d = {d}")
+            L, vmin, vmax = sizing.stats()
+            lipschitz = L if lipschitz is None else float(lipschitz)
+            radius_min, radius_max = vmin, vmax
+        spec = cls(d, tiles_t, lo, hi, float(radius), sizing, None if lipschitz is None else float(lipschitz),
+                   rule, float(inhibition), float(coverage), per, bool(weighted),
+                   None if radius_min is None else float(radius_min),
+                   None if radius_max is None else float(radius_max), _seed_from(rng), float(scale))
+        spec._token = spec._compute_token()
+        Tiling(spec)  # refuse a bad tiling here, with the C message, before any work
+        return spec
+
+    def _compute_token(self) -> str:
+        """A hash of everything that decides the points (a resumed run must match it)."""
+        h = hashlib.sha256()
+        h.update(repr(self.describe()).encode())
+        s = self.sizing
+        if isinstance(s, np.ndarray):
+            h.update(s.tobytes())
+        elif isinstance(s, GridSource):
+            h.update(s.token().encode())
+        elif callable(s):
+            import cloudpickle
+            h.update(cloudpickle.dumps(s))
+        return h.hexdigest()[:32]
+
+    @property
+    def token(self) -> str:
+        return self._token
+
+    def describe(self) -> dict:
+        """The parameters as plain values (for the store's attributes)."""
+        s = self.sizing
+        kind = ("radius" if s is None else "grid" if isinstance(s, np.ndarray) else
+                "grid-per-tile" if isinstance(s, GridSource) else "callable")
+        return {"d": self.d, "tiles": list(self.tiles), "l_bounds": list(self.l_bounds),
+                "u_bounds": list(self.u_bounds), "radius": self.radius, "sizing": kind,
+                "lipschitz": self.lipschitz, "rule": self.rule, "inhibition": self.inhibition,
+                "coverage": self.coverage, "periodic": None if self.periodic is None else list(self.periodic),
+                "weighted": self.weighted, "radius_min": self.radius_min,
+                "radius_max": self.radius_max, "seed": self.seed, "scale": self.scale}
+
+
+class _CallbackOwner:
+    """What vpds_py_sizing_batch needs: d, the callable, and a slot for its exception."""
+
+    def __init__(self, d: int, fn: Callable[[np.ndarray], np.ndarray]):
+        self.d = d
+        self._sizing_fn = fn
+        self._callback_error: Optional[BaseException] = None
+
+
+class Tiling:
+    """The C vpds_tiling of a spec, and the run of one tile."""
+
+    def __init__(self, spec: TilingSpec):
+        self.spec = spec
+        d = spec.d
+        self._keep: list = []
+        desc = ffi.new("vpds_desc *", lib.vpds_default_desc())
+        desc.dim = d
+        lo = ffi.new("double[]", list(spec.l_bounds))
+        hi = ffi.new("double[]", list(spec.u_bounds))
+        desc.lo, desc.hi = lo, hi
+        self._keep += [lo, hi]
+        if spec.periodic is not None:
+            per = ffi.new("int[]", [1 if p else 0 for p in spec.periodic])
+            desc.periodic = per
+            self._keep.append(per)
+        desc.radius = spec.radius
+        self._owner = None
+        self._grid = None
+        s = spec.sizing
+        if isinstance(s, np.ndarray):
+            self._grid = SizingGrid(s, spec.l_bounds, spec.u_bounds)
+            desc.sizing_grid = self._grid._ptr
+        elif callable(s) and not isinstance(s, GridSource):
+            self._owner = _CallbackOwner(d, s)
+            self._handle = ffi.new_handle(self._owner)
+            desc.sizing_batch = lib.vpds_py_sizing_batch
+            desc.sizing_user = self._handle
+        if spec.lipschitz is not None:
+            desc.lipschitz = spec.lipschitz
+        if spec.radius_min is not None:
+            desc.radius_min = spec.radius_min
+        if spec.radius_max is not None:
+            desc.radius_max = spec.radius_max
+        desc.rule = RULES[spec.rule]
+        desc.inhibition = spec.inhibition
+        desc.coverage = spec.coverage
+        desc.weighted = 1 if spec.weighted else 0
+        desc.seed = spec.seed
+        self._desc = desc
+        tiles = ffi.new("uint64_t[]", list(spec.tiles))
+        self._keep.append(tiles)
+        tdesc = ffi.new("vpds_tiling_desc *", lib.vpds_default_tiling_desc())
+        tdesc.sampler = desc
+        tdesc.tiles = tiles
+        tdesc.scale = spec.scale
+        tdesc.sizing_per_tile = 1 if isinstance(s, GridSource) else 0
+        msg = ffi.new("char[]", 1024)
+        st = lib.vpds_tiling_validate(tdesc, msg, 1024)
+        if st != lib.VPDS_OK:
+            _raise(st, ffi.string(msg).decode())
+        out = ffi.new("vpds_tiling **")
+        st = lib.vpds_tiling_create(tdesc, out)
+        if st != lib.VPDS_OK:
+            _raise(st, "vpds_tiling_create failed")
+        self._t = ffi.gc(out[0], lib.vpds_tiling_destroy)
+
+    # -- the grid of tiles ---------------------------------------------------------------------
+    @property
+    def count(self) -> int:
+        return int(lib.vpds_tiling_count(self._t))
+
+    @property
+    def margin(self) -> float:
+        return float(lib.vpds_tiling_margin(self._t))
+
+    def _check_tile(self, tile: int) -> int:
+        tile = int(tile)
+        if not 0 <= tile < self.count:
+            raise ValueError(f"tile = {tile}: the tiling has tiles 0..{self.count - 1}")
+        return tile
+
+    def phase(self, tile: int) -> int:
+        return int(lib.vpds_tiling_phase(self._t, self._check_tile(tile)))
+
+    def seed(self, tile: int) -> int:
+        return int(lib.vpds_tiling_seed(self._t, self._check_tile(tile)))
+
+    def box(self, tile: int) -> tuple[np.ndarray, np.ndarray]:
+        lo = ffi.new("double[]", self.spec.d)
+        hi = ffi.new("double[]", self.spec.d)
+        lib.vpds_tiling_box(self._t, self._check_tile(tile), lo, hi)
+        return np.array(list(lo)), np.array(list(hi))
+
+    def coords(self, tile: int) -> tuple:
+        c = ffi.new("uint64_t[]", self.spec.d)
+        lib.vpds_tiling_coords(self._t, self._check_tile(tile), c)
+        return tuple(int(v) for v in c)
+
+    def index(self, coords: Sequence[int]) -> int:
+        c = ffi.new("int64_t[]", [int(v) for v in coords])
+        out = ffi.new("uint64_t *")
+        if lib.vpds_tiling_index(self._t, c, out) != lib.VPDS_OK:
+            raise ValueError(f"coords = {tuple(coords)}: outside the tiles {self.spec.tiles} on a closed axis")
+        return int(out[0])
+
+    def deps(self, tile: int) -> list[int]:
+        """The tiles whose samples this tile's run needs (its neighbours of lower phase)."""
+        cap = 3 ** self.spec.d - 1  # VPDS_TILING_MAX_DEPS for this dimension
+        buf = ffi.new("uint64_t[]", cap)
+        n = ffi.new("size_t *")
+        lib.vpds_tiling_deps(self._t, self._check_tile(tile), buf, cap, n)
+        return [int(buf[i]) for i in range(n[0])]
+
+    def cone(self, tile: int) -> list[int]:
+        """Every tile this tile needs, directly or not, in an order that can run."""
+        n = ffi.new("size_t *")
+        st = lib.vpds_tiling_cone(self._t, self._check_tile(tile), ffi.NULL, 0, n)
+        if st not in (lib.VPDS_OK, lib.VPDS_ERR_OVERFLOW) or (st != lib.VPDS_OK and n[0] == 0):
+            _raise(st, f"tile {tile}: the cone is too large to list")
+        buf = ffi.new("uint64_t[]", max(1, n[0]))
+        st = lib.vpds_tiling_cone(self._t, tile, buf, n[0], n)
+        if st != lib.VPDS_OK:
+            _raise(st, f"tile {tile}: the cone is too large to list")
+        return [int(buf[i]) for i in range(n[0])]
+
+    def order(self) -> list[int]:
+        """All tiles in an order that can run one after another: by phase, then index."""
+        return sorted(range(self.count), key=lambda k: (self.phase(k), k))
+
+    def window_range(self, tile: int) -> tuple[list[int], list[int]]:
+        """Node offsets and counts of the grid window that covers this tile's core (with one
+        node to spare on each side)."""
+        src = self.spec.sizing
+        shape = src.shape if isinstance(src, GridSource) else np.shape(src)
+        lo, hi = self.box(tile)
+        off, cnt = [], []
+        for k in range(self.spec.d):
+            step = (self.spec.u_bounds[k] - self.spec.l_bounds[k]) / (shape[k] - 1)
+            a0 = max(0, math.floor((lo[k] - self.spec.l_bounds[k]) / step) - 1)
+            a1 = min(shape[k], math.floor((hi[k] - self.spec.l_bounds[k]) / step) + 3)
+            off.append(a0)
+            cnt.append(a1 - a0)
+        return off, cnt
+
+    # -- one tile's run ------------------------------------------------------------------------
+    def run_tile(self, tile: int, deps: Mapping[int, tuple[np.ndarray, np.ndarray]],
+                 budget: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The tile's own samples (points (n, d), radii (n,), scales (n,)) from its
+        dependencies' samples: deps[k] = (points, radii) of tile k, for every k in deps(tile)."""
+        tile = self._check_tile(tile)
+        d = self.spec.d
+        keep = []
+        pts = ffi.new("vpds_tile_points[]", max(1, len(deps)))
+        for i, (k, (x, r)) in enumerate(sorted(deps.items())):
+            x = np.ascontiguousarray(x, dtype=np.float64).reshape(-1, d)
+            r = np.ascontiguousarray(r, dtype=np.float64).reshape(-1)
+            keep += [x, r]
+            pts[i].tile = int(k)
+            pts[i].x = ffi.cast("const double *", ffi.from_buffer(x)) if len(x) else ffi.NULL
+            pts[i].r = ffi.cast("const double *", ffi.from_buffer(r)) if len(r) else ffi.NULL
+            pts[i].n = len(x)
+        window = ffi.NULL
+        if isinstance(self.spec.sizing, GridSource):
+            window = self._window(tile)
+            keep.append(window)
+        out = ffi.new("vpds_sampler **")
+        nfix = ffi.new("size_t *")
+        msg = ffi.new("char[]", 1024)
+        st = lib.vpds_tile_create(self._t, tile, pts, len(deps), window, out, nfix, msg, 1024)
+        if st != lib.VPDS_OK:
+            _raise(st, ffi.string(msg).decode())
+        s = ffi.gc(out[0], lib.vpds_destroy)
+        lib.vpds_set_budget(s, budget)
+        while True:
+            st = lib.vpds_run(s)
+            if st < 0:
+                cause = None
+                if self._owner is not None:
+                    cause, self._owner._callback_error = self._owner._callback_error, None
+                _raise(st, ffi.string(lib.vpds_last_error(s)).decode(), cause)
+            if st == lib.VPDS_OK:
+                break
+        n, f = int(lib.vpds_count(s)), int(nfix[0])
+        x = np.frombuffer(ffi.buffer(lib.vpds_points(s), n * d * 8), dtype=np.float64).reshape(n, d)[f:].copy()
+        r = np.frombuffer(ffi.buffer(lib.vpds_radii(s), n * 8), dtype=np.float64)[f:].copy()
+        t = np.frombuffer(ffi.buffer(lib.vpds_scales(s), n * 8), dtype=np.float64)[f:].copy()
+        return x, r, t
+
+    def _window(self, tile: int):
+        src: GridSource = self.spec.sizing  # type: ignore[assignment]
+        off, cnt = self.window_range(tile)
+        values = np.ascontiguousarray(src.window(off, [o + c for o, c in zip(off, cnt)]), dtype=np.float64)
+        return src.make_window(values, off)
