@@ -227,3 +227,39 @@ def test_bad_domains():
     with pytest.raises(vpds.VpdsDomainError) as info:
         vpds.PoissonDisk(2, domain=boom, progress=False).fill_space()
     assert isinstance(info.value.__cause__, RuntimeError)
+
+
+def test_bias_free_in_a_domain():
+    """Eq. 4 inside a domain: sample k+1 is uniform over the free part of the annulus. Ranks of
+    x_{k+1} among the free pixels inside the domain (by x, y, distance to the nearest sample) are
+    Uniform(0, 1); Bridson's annulus insertion from the same prefixes is rejected."""
+    from scipy import stats
+    from test_bias import bridson_next, free_mask, ranks
+
+    from vpds import analysis as C
+    sizing = C.sizing_named("const", 0.08)
+    rng = np.random.default_rng(11)
+    ours, biased = [], []
+    for seed in range(320):
+        e = vpds.PoissonDisk(2, radius=0.08, domain=annulus, rng=3000 + seed, progress=False)
+        x = e.fill_space()
+        r = e.radii
+        k = int(rng.integers(1, len(x)))
+        pts, free = free_mask(x[:k], r[:k], "smaller", sizing, 0.0, 1.0, 0.0)
+        free &= annulus(pts) <= 0
+        if free.sum() < 20:
+            continue
+        ours.append(ranks(pts, free, x[:k], x[k]))
+        for _ in range(50):  # Bridson's insertion, kept inside the domain
+            y = bridson_next(x[:k], r[:k], "smaller", sizing, 0.0, 1.0, rng)
+            if y is None or annulus(y[None, :])[0] <= 0:
+                break
+        if y is not None and annulus(y[None, :])[0] <= 0:
+            biased.append(ranks(pts, free, x[:k], y))
+    ours, biased = np.array(ours), np.array(biased)
+    assert len(ours) > 200 and len(biased) > 150
+    p_ours = [stats.kstest(ours[:, j][~np.isnan(ours[:, j])], "uniform").pvalue for j in range(3)]
+    p_biased = [stats.kstest(biased[:, j][~np.isnan(biased[:, j])], "uniform").pvalue for j in range(3)]
+    print(f"annulus: KS p-values ours {p_ours}, Bridson {p_biased}")
+    assert min(p_ours) > 1e-3, p_ours
+    assert min(p_biased) < 1e-3, p_biased
