@@ -109,7 +109,10 @@ def cluster():
     client = Client(c)
     yield c, client
     client.close()
-    c.close()
+    try:
+        c.close()
+    except KeyError:  # dask's bookkeeping of a worker it restarted; the cluster is closed
+        pass
 
 
 ARGS = dict(u_bounds=(1.0, 0.9), sizing=wave, lipschitz=WAVE_L, radius_max=0.04, rule="bigger", rng=7)
