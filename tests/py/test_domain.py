@@ -139,7 +139,7 @@ def test_image_domain_and_cli(tmp_path):
     assert np.array_equal(np.load(out)["points"], x)
     res = subprocess.run([sys.executable, "-m", "vpds", "sample", "--domain", str(tmp_path / "m.png"),
                           "--domain-threshold", "2", "--no-progress"], capture_output=True, text=True)
-    assert res.returncode != 0 and "no value is >= threshold" in res.stderr
+    assert res.returncode == 2 and "no value is >= threshold" in res.stderr
 
 
 def test_3d_ball_and_torus():

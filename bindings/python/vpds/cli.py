@@ -144,8 +144,11 @@ def cmd_sample(args: argparse.Namespace) -> int:
                              inhibition=args.inhibition, coverage=args.coverage, periodic=periodic,
                              progress=not args.no_progress, domain=domain,
                              domain_threshold=args.domain_threshold)
-    except (ValueError, ImportError, OSError) as exc:
-        raise SystemExit(f"vpds sample: {exc}") from None
+    except VpdsError:
+        raise  # main prints the C message and exits with 2
+    except (ValueError, ImportError, OSError) as exc:  # a domain file or polygon refused
+        print(f"vpds sample: {exc}", file=sys.stderr)
+        return 2
     t0 = time.perf_counter()
     if args.stream:
         for _ in zip(range(args.stream), engine.stream()):
