@@ -456,6 +456,14 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
             r_lo = s->buf_r[j] - L * h / 2;
             r_hi = s->buf_r[j] + L * h / 2;
         }
+        if (s->domain) {
+            for (k = 0; k < d; k++) centre[k] = 0.5 * (lo[k] + hi[k]);
+            if ((st = vpdsi_domain_at(s, centre, &phi)) != VPDS_OK) return st;
+            if (phi > 0.5 * h) { /* outside the domain, whole */
+                run->pos++;
+                continue;
+            }
+        }
         s->n_cand = 0;
         if (s->grid_mode) {
             uint64_t base[VPDS_MAX_DIM];
@@ -466,14 +474,6 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
                                    &s->mem, &s->cand, &s->n_cand, &s->cap_cand)) {
             vpdsi_set_error(s, "out of memory gathering the samples near a cell");
             return VPDS_ERR_OUT_OF_MEMORY;
-        }
-        if (s->domain) {
-            for (k = 0; k < d; k++) centre[k] = 0.5 * (lo[k] + hi[k]);
-            if ((st = vpdsi_domain_at(s, centre, &phi)) != VPDS_OK) return st;
-            if (phi > 0.5 * h) { /* outside the domain, whole */
-                run->pos++;
-                continue;
-            }
         }
         if (box_covered(s, lo, hi, r_lo, scale)) {
             run->pos++;
