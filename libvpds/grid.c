@@ -1,6 +1,7 @@
 /* Built-in sizing: a regular grid with multilinear interpolation, its exact Lipschitz constant,
  * and the Lipschitz envelope ("smoothed for L", Section 7 / Figure 12). */
 #include "grid.h"
+#include "refuse.h"
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -15,43 +16,42 @@ vpds_grid_desc vpds_default_grid_desc(void)
     return d;
 }
 
-#define FAIL(st, ...) do { if (msg && cap) snprintf(msg, cap, __VA_ARGS__); return st; } while (0)
 
 vpds_status vpds_grid_validate(const vpds_grid_desc *d, char *msg, size_t cap)
 {
     size_t n = 1, k, i;
     if (msg && cap) msg[0] = 0;
-    if (!d) FAIL(VPDS_ERR_INVALID_ARGUMENT, "desc is NULL");
+    if (!d) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc is NULL");
     if (d->cookie != VPDSI_GRID_COOKIE)
-        FAIL(VPDS_ERR_BAD_DESCRIPTOR, "grid desc: cookie 0x%08x is not from vpds_default_grid_desc()",
+        VPDSI_REFUSE(VPDS_ERR_BAD_DESCRIPTOR, "grid desc: cookie 0x%08x is not from vpds_default_grid_desc()",
              (unsigned)d->cookie);
     if (d->struct_size != sizeof *d)
-        FAIL(VPDS_ERR_BAD_DESCRIPTOR, "grid desc: struct_size %u, this library reads %u",
+        VPDSI_REFUSE(VPDS_ERR_BAD_DESCRIPTOR, "grid desc: struct_size %u, this library reads %u",
              (unsigned)d->struct_size, (unsigned)sizeof *d);
     if (d->dim < 1 || d->dim > VPDS_MAX_DIM)
-        FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: dim = %d, must be in 1..%d", d->dim, VPDS_MAX_DIM);
-    if (!d->shape) FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: shape is NULL");
-    if (!d->values) FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: values is NULL");
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "grid desc: dim = %d, must be in 1..%d", d->dim, VPDS_MAX_DIM);
+    if (!d->shape) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "grid desc: shape is NULL");
+    if (!d->values) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "grid desc: values is NULL");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
-        FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: allocator.alloc and allocator.free must both be set or both NULL");
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "grid desc: allocator.alloc and allocator.free must both be set or both NULL");
     for (k = 0; k < (size_t)d->dim; k++) {
         double lo = d->lo ? d->lo[k] : 0.0, hi = d->hi ? d->hi[k] : 1.0;
         if (d->shape[k] < 2)
-            FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: shape[%u] = %zu, need at least 2 nodes per axis",
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "grid desc: shape[%u] = %zu, need at least 2 nodes per axis",
                  (unsigned)k, d->shape[k]);
         if (vpdsi_mul_size(n, d->shape[k], &n) != 0 || n > ((size_t)-1) / (2 * sizeof(double)))
-            FAIL(VPDS_ERR_OVERFLOW, "grid desc: the node count overflows at shape[%u] = %zu",
+            VPDSI_REFUSE(VPDS_ERR_OVERFLOW, "grid desc: the node count overflows at shape[%u] = %zu",
                  (unsigned)k, d->shape[k]);
         if (!isfinite(lo) || !isfinite(hi) || !(lo < hi))
-            FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: axis %u has lo = %g, hi = %g; need finite lo < hi",
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "grid desc: axis %u has lo = %g, hi = %g; need finite lo < hi",
                  (unsigned)k, lo, hi);
         if (!isfinite(hi - lo) || !((hi - lo) / (double)(d->shape[k] - 1) > 0))
-            FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: axis %u: the node spacing (%g - %g) / %zu is "
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "grid desc: axis %u: the node spacing (%g - %g) / %zu is "
                  "not a positive finite number", (unsigned)k, hi, lo, d->shape[k] - 1);
     }
     for (i = 0; i < n; i++)
         if (!(d->values[i] >= 1e-100 && d->values[i] <= 1e100))
-            FAIL(VPDS_ERR_INVALID_ARGUMENT, "grid desc: values[%zu] = %g; radii must be finite and > 0 "
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "grid desc: values[%zu] = %g; radii must be finite and > 0 "
                  "(within [1e-100, 1e100])", i, d->values[i]);
     return VPDS_OK;
 }
@@ -287,19 +287,19 @@ vpds_status vpds_grid_validate_window(const vpds_grid_desc *d, const size_t *who
     vpds_status st = vpds_grid_validate(d, msg, cap);
     size_t k;
     if (st != VPDS_OK) return st;
-    if (!whole) FAIL(VPDS_ERR_INVALID_ARGUMENT, "whole_shape is NULL");
-    if (!offset) FAIL(VPDS_ERR_INVALID_ARGUMENT, "offset is NULL");
+    if (!whole) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "whole_shape is NULL");
+    if (!offset) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "offset is NULL");
     for (k = 0; k < (size_t)d->dim; k++) {
         double lo = d->lo ? d->lo[k] : 0.0, hi = d->hi ? d->hi[k] : 1.0;
         if (whole[k] < 2)
-            FAIL(VPDS_ERR_INVALID_ARGUMENT, "whole_shape[%u] = %zu: need at least 2 nodes per axis",
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "whole_shape[%u] = %zu: need at least 2 nodes per axis",
                  (unsigned)k, whole[k]);
         if (offset[k] > whole[k] || d->shape[k] > whole[k] - offset[k])
-            FAIL(VPDS_ERR_INVALID_ARGUMENT, "offset[%u] = %zu + shape[%u] = %zu exceeds whole_shape[%u] "
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "offset[%u] = %zu + shape[%u] = %zu exceeds whole_shape[%u] "
                  "= %zu: the window must lie inside the grid", (unsigned)k, offset[k], (unsigned)k,
                  d->shape[k], (unsigned)k, whole[k]);
         if (!((hi - lo) / (double)(whole[k] - 1) > 0))
-            FAIL(VPDS_ERR_INVALID_ARGUMENT, "axis %u: the node spacing (%g - %g) / %zu is not a "
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "axis %u: the node spacing (%g - %g) / %zu is not a "
                  "positive finite number", (unsigned)k, hi, lo, whole[k] - 1);
     }
     return VPDS_OK;

@@ -5,6 +5,7 @@
  * The multilinear interpolant between centres (the grid sizing's) can be up to sqrt(d) times
  * steeper; its exact constant L is computed and the values divided by it when above 1. */
 #include "grid.h"
+#include "refuse.h"
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -29,44 +30,43 @@ vpds_mask_desc vpds_default_mask_desc(void)
     return d;
 }
 
-#define FAIL(st, ...) do { if (msg && cap) snprintf(msg, cap, __VA_ARGS__); return st; } while (0)
 
 vpds_status vpds_mask_validate(const vpds_mask_desc *d, char *msg, size_t cap)
 {
     size_t n = 1, k, i, inside = 0;
     if (msg && cap) msg[0] = 0;
-    if (!d) FAIL(VPDS_ERR_INVALID_ARGUMENT, "mask desc is NULL");
+    if (!d) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "mask desc is NULL");
     if (d->cookie != VPDSI_MASK_COOKIE)
-        FAIL(VPDS_ERR_BAD_DESCRIPTOR, "mask desc: cookie 0x%08x is not from vpds_default_mask_desc()",
+        VPDSI_REFUSE(VPDS_ERR_BAD_DESCRIPTOR, "mask desc: cookie 0x%08x is not from vpds_default_mask_desc()",
              (unsigned)d->cookie);
     if (d->struct_size != sizeof *d)
-        FAIL(VPDS_ERR_BAD_DESCRIPTOR, "mask desc: struct_size %u, this library reads %u",
+        VPDSI_REFUSE(VPDS_ERR_BAD_DESCRIPTOR, "mask desc: struct_size %u, this library reads %u",
              (unsigned)d->struct_size, (unsigned)sizeof *d);
     if (d->dim < 1 || d->dim > VPDS_MAX_DIM)
-        FAIL(VPDS_ERR_INVALID_ARGUMENT, "mask desc: dim = %d, must be in 1..%d", d->dim, VPDS_MAX_DIM);
-    if (!d->shape || !d->values) FAIL(VPDS_ERR_INVALID_ARGUMENT, "mask desc: shape or values is NULL");
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "mask desc: dim = %d, must be in 1..%d", d->dim, VPDS_MAX_DIM);
+    if (!d->shape || !d->values) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "mask desc: shape or values is NULL");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
-        FAIL(VPDS_ERR_INVALID_ARGUMENT, "mask desc: allocator.alloc and allocator.free must both be "
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "mask desc: allocator.alloc and allocator.free must both be "
              "set or both NULL");
     if (!isfinite(d->threshold))
-        FAIL(VPDS_ERR_INVALID_ARGUMENT, "mask desc: threshold = %g, must be finite", d->threshold);
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "mask desc: threshold = %g, must be finite", d->threshold);
     for (k = 0; k < (size_t)d->dim; k++) {
         double lo = d->lo ? d->lo[k] : 0.0, hi = d->hi ? d->hi[k] : 1.0;
         if (d->shape[k] < 2)
-            FAIL(VPDS_ERR_INVALID_ARGUMENT, "mask desc: shape[%zu] = %zu, need at least 2 cells per axis",
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "mask desc: shape[%zu] = %zu, need at least 2 cells per axis",
                  k, d->shape[k]);
         if (vpdsi_mul_size(n, d->shape[k], &n) != 0 || n > ((size_t)-1) / (4 * sizeof(double)))
-            FAIL(VPDS_ERR_OVERFLOW, "mask desc: the cell count overflows at shape[%zu] = %zu", k, d->shape[k]);
+            VPDSI_REFUSE(VPDS_ERR_OVERFLOW, "mask desc: the cell count overflows at shape[%zu] = %zu", k, d->shape[k]);
         if (!isfinite(lo) || !isfinite(hi) || !(lo < hi) || !isfinite(hi - lo))
-            FAIL(VPDS_ERR_INVALID_ARGUMENT, "mask desc: axis %zu has lo = %g, hi = %g; need finite lo < hi",
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "mask desc: axis %zu has lo = %g, hi = %g; need finite lo < hi",
                  k, lo, hi);
     }
     for (i = 0; i < n; i++) {
-        if (isnan(d->values[i])) FAIL(VPDS_ERR_INVALID_ARGUMENT, "mask desc: values[%zu] is NaN", i);
+        if (isnan(d->values[i])) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "mask desc: values[%zu] is NaN", i);
         inside += d->values[i] >= d->threshold;
     }
     if (inside == 0)
-        FAIL(VPDS_ERR_INVALID_ARGUMENT, "mask desc: no value is >= threshold = %g: the domain would be "
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "mask desc: no value is >= threshold = %g: the domain would be "
              "empty", d->threshold);
     return VPDS_OK;
 }
@@ -87,18 +87,12 @@ static void edt_line(const double *f, size_t n, double h, double *out, size_t *v
             m = 1;
             continue;
         }
-        for (;;) {
+        for (;;) { /* z[0] = -INFINITY: this stops at k = 0 at the latest */
             double pv = h * (double)v[k];
             double s = ((f[q] + pq * pq) - (f[v[k]] + pv * pv)) / (2 * (pq - pv));
-            if (s <= z[k] && k > 0) {
+            if (s <= z[k]) {
                 k--;
                 continue;
-            }
-            if (s <= z[k]) { /* k == 0: the new parabola is lower everywhere */
-                v[0] = q;
-                z[0] = -INFINITY;
-                z[1] = INFINITY;
-                break;
             }
             k++;
             v[k] = q;

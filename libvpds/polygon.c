@@ -2,6 +2,7 @@
  * the nearest edge, negative when a ray crosses the rings an odd number of times. Validation
  * finds crossing edges by a sweep over edges sorted by their lowest x. */
 #include "mem.h"
+#include "refuse.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,7 +29,6 @@ vpds_polygon_desc vpds_default_polygon_desc(void)
     return d;
 }
 
-#define FAIL(st, ...) do { if (msg && cap) snprintf(msg, cap, __VA_ARGS__); return st; } while (0)
 
 typedef struct {
     double xmin, xmax, ymin, ymax;
@@ -78,33 +78,33 @@ vpds_status vpds_polygon_validate(const vpds_polygon_desc *d, char *msg, size_t 
     poly_edge *edges;
     vpdsi_mem m;
     if (msg && cap) msg[0] = 0;
-    if (!d) FAIL(VPDS_ERR_INVALID_ARGUMENT, "polygon desc is NULL");
+    if (!d) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "polygon desc is NULL");
     if (d->cookie != VPDSI_POLYGON_COOKIE)
-        FAIL(VPDS_ERR_BAD_DESCRIPTOR, "polygon desc: cookie 0x%08x is not from "
+        VPDSI_REFUSE(VPDS_ERR_BAD_DESCRIPTOR, "polygon desc: cookie 0x%08x is not from "
              "vpds_default_polygon_desc()", (unsigned)d->cookie);
     if (d->struct_size != sizeof *d)
-        FAIL(VPDS_ERR_BAD_DESCRIPTOR, "polygon desc: struct_size %u, this library reads %u",
+        VPDSI_REFUSE(VPDS_ERR_BAD_DESCRIPTOR, "polygon desc: struct_size %u, this library reads %u",
              (unsigned)d->struct_size, (unsigned)sizeof *d);
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
-        FAIL(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: allocator.alloc and allocator.free must both "
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: allocator.alloc and allocator.free must both "
              "be set or both NULL");
-    if (d->n_rings == 0) FAIL(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: n_rings = 0, need a ring");
-    if (!d->xy || !d->ring_sizes) FAIL(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: xy or ring_sizes is NULL");
+    if (d->n_rings == 0) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: n_rings = 0, need a ring");
+    if (!d->xy || !d->ring_sizes) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: xy or ring_sizes is NULL");
     for (r = 0; r < d->n_rings; r++) {
         if (d->ring_sizes[r] < 3)
-            FAIL(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: ring_sizes[%zu] = %zu, a ring needs at "
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: ring_sizes[%zu] = %zu, a ring needs at "
                  "least 3 vertices", r, d->ring_sizes[r]);
         if (total + d->ring_sizes[r] < total || total + d->ring_sizes[r] > ((size_t)-1) / (2 * sizeof(poly_edge)))
-            FAIL(VPDS_ERR_OVERFLOW, "polygon desc: the vertex count overflows at ring %zu", r);
+            VPDSI_REFUSE(VPDS_ERR_OVERFLOW, "polygon desc: the vertex count overflows at ring %zu", r);
         total += d->ring_sizes[r];
     }
     for (i = 0; i < 2 * total; i++)
         if (!isfinite(d->xy[i]) || fabs(d->xy[i]) > 1e150)
-            FAIL(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: xy[%zu] = %g, vertices must be finite "
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: xy[%zu] = %g, vertices must be finite "
                  "(within 1e150)", i, d->xy[i]);
     vpdsi_mem_init(&m, &d->allocator);
     edges = (poly_edge *)vpdsi_mem_alloc(&m, total * sizeof *edges);
-    if (!edges) FAIL(VPDS_ERR_OUT_OF_MEMORY, "polygon desc: out of memory for %zu edges", total);
+    if (!edges) VPDSI_REFUSE(VPDS_ERR_OUT_OF_MEMORY, "polygon desc: out of memory for %zu edges", total);
     for (r = 0, at = 0, i = 0; r < d->n_rings; at += d->ring_sizes[r], r++) {
         for (j = 0; j < d->ring_sizes[r]; j++, i++) {
             poly_edge *e = edges + i;
@@ -119,7 +119,7 @@ vpds_status vpds_polygon_validate(const vpds_polygon_desc *d, char *msg, size_t 
             e->ymax = fmax(a[1], b[1]);
             if (a[0] == b[0] && a[1] == b[1]) {
                 vpdsi_mem_free(&m, edges, total * sizeof *edges);
-                FAIL(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: ring %zu repeats vertex %zu at (%g, %g)"
+                VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: ring %zu repeats vertex %zu at (%g, %g)"
                      " (a zero-length edge)", r, j, a[0], a[1]);
             }
         }
@@ -133,7 +133,7 @@ vpds_status vpds_polygon_validate(const vpds_polygon_desc *d, char *msg, size_t 
                 size_t er = e->ring, ee = e->edge, fr = f->ring, fe = f->edge;
                 double x = d->xy[2 * e->a], y = d->xy[2 * e->a + 1];
                 vpdsi_mem_free(&m, edges, total * sizeof *edges);
-                FAIL(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: edge %zu of ring %zu (from (%g, %g)) "
+                VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: edge %zu of ring %zu (from (%g, %g)) "
                      "crosses or touches edge %zu of ring %zu: the polygon intersects itself",
                      ee, er, x, y, fe, fr);
             }
@@ -147,7 +147,7 @@ vpds_status vpds_polygon_validate(const vpds_polygon_desc *d, char *msg, size_t 
                          *s = d->xy + 2 * (at + (j + 2) % n);
             if (orient(p, q, s) == 0 && (q[0] - p[0]) * (s[0] - q[0]) + (q[1] - p[1]) * (s[1] - q[1]) < 0) {
                 vpdsi_mem_free(&m, edges, total * sizeof *edges);
-                FAIL(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: ring %zu folds back on itself at vertex "
+                VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: ring %zu folds back on itself at vertex "
                      "%zu (%g, %g)", r, (j + 1) % n, q[0], q[1]);
             }
         }

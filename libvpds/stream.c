@@ -189,7 +189,7 @@ static vpds_status eval_boxes(vpds_sampler *s, const double *centres, size_t n, 
         if (s->domain) {
             /* a box outside the domain holds no candidate; a centre outside is none itself */
             if ((e = vpdsi_domain_at(s, c, &phi)) != VPDS_OK) return e;
-            if (phi > h || (h == 0 && phi > 0)) {
+            if (phi > h) {
                 g[j] = ub[j] = -1;
                 continue;
             }

@@ -3,6 +3,7 @@
  * earlier-phase neighbours within the margin as fixed points). Nothing here is mutable after
  * create: temporary memory goes through a copy of the allocator, so threads may share a tiling. */
 #include "tiles.h"
+#include "refuse.h"
 #include "rules.h"
 #include "sampler.h"
 #include <math.h>
@@ -17,7 +18,6 @@
  * can then only add fixed points that do not matter, never drop one that does. */
 #define TILES_MARGIN_SLACK 1e-9
 
-#define TFAIL(st, ...) do { if (msg && cap) snprintf(msg, cap, __VA_ARGS__); return st; } while (0)
 
 static int tiles_live(const vpds_tiling *t) { return t && t->magic == VPDSI_TILING_MAGIC; }
 
@@ -39,23 +39,23 @@ static vpds_status tiles_sizing_params(const vpds_tiling_desc *d, double *L, dou
     int callback = s->sizing != NULL || s->sizing_batch != NULL;
     if (d->sizing_per_tile) {
         if (callback || s->sizing_grid)
-            TFAIL(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.sizing_per_tile is set and desc.sampler has "
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.sizing_per_tile is set and desc.sampler has "
                   "a sizing too: give the sizing per tile (grid windows) or in the sampler, not both");
         if (s->lipschitz == VPDS_UNSET)
-            TFAIL(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.sizing_per_tile needs desc.sampler->lipschitz "
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.sizing_per_tile needs desc.sampler->lipschitz "
                   "(the whole grid's L, which every tile must share)");
         if (!(s->radius_max > 0))
-            TFAIL(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.sizing_per_tile needs desc.sampler->radius_max "
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.sizing_per_tile needs desc.sampler->radius_max "
                   "(the whole grid's largest value: it sets the margin)");
         if (s->weighted && !(s->radius_min > 0))
-            TFAIL(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.sizing_per_tile with weighted needs "
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.sizing_per_tile with weighted needs "
                   "desc.sampler->radius_min (the whole grid's smallest value)");
         *L = s->lipschitz;
         *rmin = s->radius_min;
         *rmax = s->radius_max;
     } else if (callback) {
         if (!(s->radius_max > 0))
-            TFAIL(VPDS_ERR_INVALID_ARGUMENT, "desc.sampler->radius_max = %g: a tiling with a sizing "
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.sampler->radius_max = %g: a tiling with a sizing "
                   "callback needs an upper bound of r (it sets the margin, the reach of a disk)",
                   s->radius_max);
         *L = s->lipschitz;
@@ -81,27 +81,27 @@ vpds_status vpds_tiling_validate(const vpds_tiling_desc *d, char *msg, size_t ca
     int k;
     vpds_rule rule;
     if (msg && cap) msg[0] = 0;
-    if (!d) TFAIL(VPDS_ERR_INVALID_ARGUMENT, "tiling desc is NULL");
+    if (!d) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling desc is NULL");
     if (d->cookie != VPDSI_TILING_DESC_COOKIE)
-        TFAIL(VPDS_ERR_BAD_DESCRIPTOR, "tiling desc.cookie = 0x%08x: the descriptor did not come from "
+        VPDSI_REFUSE(VPDS_ERR_BAD_DESCRIPTOR, "tiling desc.cookie = 0x%08x: the descriptor did not come from "
               "vpds_default_tiling_desc()", (unsigned)d->cookie);
     if (d->struct_size != sizeof *d)
-        TFAIL(VPDS_ERR_BAD_DESCRIPTOR, "tiling desc.struct_size = %u: a layout this library cannot read "
+        VPDSI_REFUSE(VPDS_ERR_BAD_DESCRIPTOR, "tiling desc.struct_size = %u: a layout this library cannot read "
               "(it reads %u)", (unsigned)d->struct_size, (unsigned)sizeof *d);
-    if (!d->sampler) TFAIL(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.sampler is NULL");
+    if (!d->sampler) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.sampler is NULL");
     if ((st = vpds_validate(d->sampler, inner, sizeof inner)) != VPDS_OK)
-        TFAIL(st, "tiling desc.sampler: %s", inner);
-    if (!d->tiles) TFAIL(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.tiles is NULL (dim tile counts)");
+        VPDSI_REFUSE(st, "tiling desc.sampler: %s", inner);
+    if (!d->tiles) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.tiles is NULL (dim tile counts)");
     if (!isfinite(d->scale) || !(d->scale > 0))
-        TFAIL(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.scale = %g: must be finite and > 0", d->scale);
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.scale = %g: must be finite and > 0", d->scale);
     if (!vpdsi_scale_ok(d->scale * d->sampler->coverage))
-        TFAIL(VPDS_ERR_OVERFLOW, "tiling desc.scale = %g: scale * coverage must be within [1e-50, 1e50]",
+        VPDSI_REFUSE(VPDS_ERR_OVERFLOW, "tiling desc.scale = %g: scale * coverage must be within [1e-50, 1e50]",
               d->scale);
     if ((st = tiles_sizing_params(d, &L, &rmin, &rmax, msg, cap)) != VPDS_OK) return st;
     rule = d->sampler->rule == VPDS_RULE_DEFAULT ? VPDS_RULE_SMALLER : d->sampler->rule;
     limit = vpdsi_rule_max_lipschitz(rule);
     if (d->scale * d->sampler->coverage * L >= limit)
-        TFAIL(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.scale = %g: scale * coverage * L = %g is at or above "
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.scale = %g: scale * coverage * L = %g is at or above "
               "the %s rule's limit %g (Table 1)", d->scale, d->scale * d->sampler->coverage * L,
               vpdsi_rule_name(rule), limit);
     margin = d->scale * d->sampler->coverage * rmax * (1 + TILES_MARGIN_SLACK);
@@ -110,19 +110,19 @@ vpds_status vpds_tiling_validate(const vpds_tiling_desc *d, char *msg, size_t ca
         double lo = d->sampler->lo ? d->sampler->lo[k] : 0.0, hi = d->sampler->hi ? d->sampler->hi[k] : 1.0;
         int per = d->sampler->periodic && d->sampler->periodic[k];
         if (n < 1 || n > TILES_MAX_PER_AXIS)
-            TFAIL(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.tiles[%d] = %llu: must be in 1..2^40", k,
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.tiles[%d] = %llu: must be in 1..2^40", k,
                   (unsigned long long)n);
         if (per && n % 2 != 0)
-            TFAIL(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.tiles[%d] = %llu: a periodic axis needs an even "
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.tiles[%d] = %llu: a periodic axis needs an even "
                   "tile count (the phases alternate by parity, and must around the wrap too)", k,
                   (unsigned long long)n);
         if (n > 1 && !((hi - lo) / (double)n >= margin))
-            TFAIL(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.tiles[%d] = %llu: the tile side %g is below the "
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.tiles[%d] = %llu: the tile side %g is below the "
                   "margin %g = scale * coverage * r_max (tiles of one phase, a side apart, would "
                   "interact); use at most %.0f tiles on this axis", k, (unsigned long long)n,
                   (hi - lo) / (double)n, margin, floor((hi - lo) / margin));
         if (count > TILES_MAX_COUNT / n)
-            TFAIL(VPDS_ERR_OVERFLOW, "tiling desc.tiles: the tile count overflows 2^62 at tiles[%d] = %llu",
+            VPDSI_REFUSE(VPDS_ERR_OVERFLOW, "tiling desc.tiles: the tile count overflows 2^62 at tiles[%d] = %llu",
                   k, (unsigned long long)n);
         count *= n;
     }
@@ -546,21 +546,21 @@ vpds_status vpds_tile_create(const vpds_tiling *t, uint64_t tile, const vpds_til
     char inner[400];
     int phase;
     if (msg && cap) msg[0] = 0;
-    if (!out) TFAIL(VPDS_ERR_INVALID_ARGUMENT, "out is NULL");
+    if (!out) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "out is NULL");
     *out = NULL;
     if (n_fixed) *n_fixed = 0;
-    if (!tiles_live(t)) TFAIL(VPDS_ERR_INVALID_ARGUMENT, "tiling is NULL or not a live vpds_tiling");
+    if (!tiles_live(t)) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling is NULL or not a live vpds_tiling");
     if (tile >= t->count)
-        TFAIL(VPDS_ERR_INVALID_ARGUMENT, "tile = %llu: the tiling has tiles 0..%llu",
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tile = %llu: the tiling has tiles 0..%llu",
               (unsigned long long)tile, (unsigned long long)(t->count - 1));
-    if (n_deps && !deps) TFAIL(VPDS_ERR_INVALID_ARGUMENT, "deps is NULL with n_deps = %zu", n_deps);
+    if (n_deps && !deps) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "deps is NULL with n_deps = %zu", n_deps);
     if (t->per_tile && !window)
-        TFAIL(VPDS_ERR_INVALID_ARGUMENT, "sizing_window is NULL: the tiling has sizing_per_tile, each "
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "sizing_window is NULL: the tiling has sizing_per_tile, each "
               "tile needs its window of the grid");
     if (!t->per_tile && window)
-        TFAIL(VPDS_ERR_INVALID_ARGUMENT, "sizing_window is given but the tiling has no sizing_per_tile");
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "sizing_window is given but the tiling has no sizing_per_tile");
     if (window && (window->magic != VPDSI_GRID_COOKIE || window->dim != t->dim))
-        TFAIL(VPDS_ERR_INVALID_ARGUMENT, "sizing_window is not a live vpds_grid of dim %d", t->dim);
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "sizing_window is not a live vpds_grid of dim %d", t->dim);
     tiles_coords_of(t, tile, c);
     phase = tiles_phase_of(t, c);
     tiles_box_of(t, c, lo, hi);

@@ -8,6 +8,8 @@ from typing import Any, Callable, Iterator, NamedTuple, Optional, Sequence, Unio
 import numpy as np
 import numpy.typing as npt
 
+from ._errors import (VpdsDomainError, VpdsError, VpdsSizingError, VpdsStateError,
+                      VpdsUnsupportedError, VpdsValueError, _raise, created)
 from ._vpds import ffi, lib
 from .domain import Domain, as_domain
 
@@ -19,46 +21,6 @@ RULES = {"prior": lib.VPDS_RULE_PRIOR, "current": lib.VPDS_RULE_CURRENT,
 # work units (darts + cells) per C call in a fill: small enough for a responsive Ctrl-C and
 # progress bar, large enough that the calls cost nothing measurable
 _CHUNK = 50_000
-
-
-class VpdsError(RuntimeError):
-    """An error status from libvpds, with the library's message (argument, value, why)."""
-
-    def __init__(self, status: int, message: str):
-        self.status = status
-        name = ffi.string(lib.vpds_status_string(status)).decode().split(":")[0]
-        super().__init__(f"{name}: {message}")
-
-
-class VpdsValueError(VpdsError, ValueError):
-    """Invalid arguments (VPDS_ERR_INVALID_ARGUMENT, VPDS_ERR_OVERFLOW, VPDS_ERR_BAD_DESCRIPTOR)."""
-
-
-class VpdsSizingError(VpdsError, ValueError):
-    """The sizing function returned a bad radius or broke its declared Lipschitz constant."""
-
-
-class VpdsUnsupportedError(VpdsError, NotImplementedError):
-    """A capability this version of libvpds does not provide yet."""
-
-
-class VpdsDomainError(VpdsError, ValueError):
-    """The domain function returned NaN, is not 1-Lipschitz, or its domain is empty."""
-
-
-class VpdsStateError(VpdsError):
-    """The call is not valid in the sampler's current state (e.g. refining to a larger t)."""
-
-
-def _raise(status: int, message: str, cause: Optional[BaseException] = None) -> None:
-    if status == lib.VPDS_ERR_OUT_OF_MEMORY:
-        raise MemoryError(message)
-    cls = {lib.VPDS_ERR_INVALID_ARGUMENT: VpdsValueError, lib.VPDS_ERR_OVERFLOW: VpdsValueError,
-           lib.VPDS_ERR_BAD_DESCRIPTOR: VpdsValueError, lib.VPDS_ERR_SIZING: VpdsSizingError,
-           lib.VPDS_ERR_LIPSCHITZ: VpdsSizingError, lib.VPDS_ERR_UNSUPPORTED: VpdsUnsupportedError,
-           lib.VPDS_ERR_STATE: VpdsStateError,
-           lib.VPDS_ERR_DOMAIN: VpdsDomainError}.get(status, VpdsError)
-    raise cls(status, message) from cause
 
 
 @ffi.def_extern()
@@ -95,15 +57,8 @@ class SizingGrid:
         desc.values = ffi.cast("const double *", ffi.from_buffer(v))
         desc.lo = self._lo
         desc.hi = self._hi
-        msg = ffi.new("char[]", 512)
-        st = lib.vpds_grid_validate(desc, msg, 512)
-        if st != lib.VPDS_OK:
-            _raise(st, ffi.string(msg).decode())
-        out = ffi.new("vpds_grid **")
-        st = lib.vpds_grid_create(desc, out)
-        if st != lib.VPDS_OK:
-            _raise(st, "vpds_grid_create failed")
-        self._ptr = ffi.gc(out[0], lib.vpds_grid_destroy)
+        self._ptr = created(lib.vpds_grid_validate, lib.vpds_grid_create, lib.vpds_grid_destroy,
+                            "vpds_grid", desc)
 
     @property
     def lipschitz(self) -> float:
@@ -280,10 +235,6 @@ class PoissonDisk:
             desc.domain_user = self._domain.user
         desc.seed = self._seed
         self._desc = desc
-        msg = ffi.new("char[]", 1024)
-        st = lib.vpds_validate(desc, msg, 1024)
-        if st != lib.VPDS_OK:
-            _raise(st, ffi.string(msg).decode())
         self._fixed = None
         if fixed_points is not None:
             fx = np.ascontiguousarray(fixed_points, dtype=np.float64).reshape(-1, self.d)
@@ -296,28 +247,31 @@ class PoissonDisk:
     # -- lifetime -----------------------------------------------------------------------------
     def reset(self) -> "PoissonDisk":
         """Back to the empty sampling (the fixed points kept), with the same seed."""
-        out = ffi.new("vpds_sampler **")
-        st = lib.vpds_create(self._desc, out)
-        if st != lib.VPDS_OK:
-            _raise(st, "vpds_create failed")
-        self._s = ffi.gc(out[0], lib.vpds_destroy)
-        self.num_generated = 0
-        if self._fixed is not None:
-            fx, fr = self._fixed
-            self._check(lib.vpds_add_points(self._s, ffi.cast("const double *", ffi.from_buffer(fx)),
-                                            ffi.NULL if fr is None else ffi.cast("const double *", ffi.from_buffer(fr)),
-                                            len(fx)))
-            self.num_generated = len(fx)
+        self._s = self._new_sampler(self._desc)
+        self.num_generated = int(lib.vpds_count(self._s))
         return self
 
-    def _check(self, st: int) -> int:
+    def _new_sampler(self, desc: Any) -> Any:
+        """A C sampler of desc (refused with the C message), holding the fixed points."""
+        s = created(lib.vpds_validate, lib.vpds_create, lib.vpds_destroy, "vpds_sampler", desc)
+        if self._fixed is not None:
+            fx, fr = self._fixed
+            self._check(lib.vpds_add_points(s, ffi.cast("const double *", ffi.from_buffer(fx)),
+                                            ffi.NULL if fr is None else ffi.cast("const double *", ffi.from_buffer(fr)),
+                                            len(fx)), s)
+        return s
+
+    def _check(self, st: int, sampler: Any = None) -> int:
+        """Raise a C error status with the message of `sampler` (default: this one's) and the
+        exception a Python callback raised, if any."""
         if st < 0:
             cause, self._callback_error = self._callback_error, None
             if cause is None and self._domain is not None:
                 cause, self._domain.error = self._domain.error, None
             if isinstance(cause, KeyboardInterrupt):
                 raise cause
-            _raise(st, ffi.string(lib.vpds_last_error(self._s)).decode(), cause)
+            _raise(st, ffi.string(lib.vpds_last_error(self._s if sampler is None else sampler)).decode(),
+                   cause)
         return st
 
     # -- sampling -----------------------------------------------------------------------------
@@ -410,33 +364,18 @@ class PoissonDisk:
             if not 0 < float(inhibition) <= 1:
                 raise ValueError(f"inhibition = {inhibition!r}: the ratio R_f / R_c must be in (0, 1]")
             desc.inhibition = float(inhibition) * desc.coverage
-        out = ffi.new("vpds_sampler **")
-        st = lib.vpds_create(desc, out)
-        if st != lib.VPDS_OK:
-            msg = ffi.new("char[]", 1024)
-            lib.vpds_validate(desc, msg, 1024)
-            _raise(st, ffi.string(msg).decode())
-        s = ffi.gc(out[0], lib.vpds_destroy)
-        saved, self._s = self._s, s  # _check reads the error of the sampler in use
-        try:
-            if self._fixed is not None:
-                fx, fr = self._fixed
-                self._check(lib.vpds_add_points(s, ffi.cast("const double *", ffi.from_buffer(fx)),
-                                                ffi.NULL if fr is None else ffi.cast("const double *", ffi.from_buffer(fr)),
-                                                len(fx)))
-            first = int(lib.vpds_count(s))
-            x = ffi.new("double[]", self.d)
-            t = ffi.new("double *")
-            for _ in range(n):
-                if self._check(lib.vpds_next(s, 0.0, x, t)) == lib.VPDS_STREAM_END:
-                    break
-            count = int(lib.vpds_count(s))
-            pts = np.frombuffer(ffi.buffer(lib.vpds_points(s), count * self.d * 8),
-                                dtype=np.float64).reshape(count, self.d)[first:].copy()
-            scales = np.frombuffer(ffi.buffer(lib.vpds_scales(s), count * 8),
-                                   dtype=np.float64)[first:].copy()
-        finally:
-            self._s = saved
+        s = self._new_sampler(desc)
+        first = int(lib.vpds_count(s))
+        x = ffi.new("double[]", self.d)
+        t = ffi.new("double *")
+        for _ in range(n):
+            if self._check(lib.vpds_next(s, 0.0, x, t), s) == lib.VPDS_STREAM_END:
+                break
+        count = int(lib.vpds_count(s))
+        pts = np.frombuffer(ffi.buffer(lib.vpds_points(s), count * self.d * 8),
+                            dtype=np.float64).reshape(count, self.d)[first:].copy()
+        scales = np.frombuffer(ffi.buffer(lib.vpds_scales(s), count * 8),
+                               dtype=np.float64)[first:].copy()
         return Progressive(pts, scales, float(scales[-1]) if len(scales) else float("inf"))
 
     def __iter__(self) -> Iterator[tuple[np.ndarray, float]]:

@@ -19,6 +19,7 @@ from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
+from ._errors import created
 from ._vpds import ffi, lib
 
 __all__ = ["Domain", "as_domain", "estimate_radius", "JAMMING_DENSITY"]
@@ -98,15 +99,9 @@ class Domain:
         desc.xy = ffi.cast("const double *", ffi.from_buffer(xy))
         desc.ring_sizes = sizes
         desc.n_rings = len(arrs)
-        msg = ffi.new("char[]", 512)
-        st = lib.vpds_polygon_validate(desc, msg, 512)
-        if st != lib.VPDS_OK:
-            raise ValueError("domain: " + ffi.string(msg).decode())
-        out = ffi.new("vpds_polygon **")
-        st = lib.vpds_polygon_create(desc, out)
-        if st != lib.VPDS_OK:
-            raise MemoryError("domain: out of memory for the polygon")
-        return cls(2, lib.vpds_polygon_sdf, ffi.gc(out[0], lib.vpds_polygon_destroy))
+        return cls(2, lib.vpds_polygon_sdf,
+                   created(lib.vpds_polygon_validate, lib.vpds_polygon_create,
+                           lib.vpds_polygon_destroy, "vpds_polygon", desc))
 
     @classmethod
     def mask(cls, values: Any, lo: Sequence[float], hi: Sequence[float],
@@ -128,15 +123,9 @@ class Domain:
         desc.values = ffi.cast("const double *", ffi.from_buffer(v))
         desc.threshold = float(threshold)
         desc.lo, desc.hi = clo, chi
-        msg = ffi.new("char[]", 512)
-        st = lib.vpds_mask_validate(desc, msg, 512)
-        if st != lib.VPDS_OK:
-            raise ValueError("domain: " + ffi.string(msg).decode())
-        out = ffi.new("vpds_mask **")
-        st = lib.vpds_mask_create(desc, out)
-        if st != lib.VPDS_OK:
-            raise MemoryError("domain: out of memory for the mask")
-        return cls(v.ndim, lib.vpds_mask_sdf, ffi.gc(out[0], lib.vpds_mask_destroy))
+        return cls(v.ndim, lib.vpds_mask_sdf,
+                   created(lib.vpds_mask_validate, lib.vpds_mask_create, lib.vpds_mask_destroy,
+                           "vpds_mask", desc))
 
 
 def _rings_of_shapely(geom: Any) -> list:

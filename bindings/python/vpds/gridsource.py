@@ -16,6 +16,7 @@ from typing import Any, Optional, Sequence, Union
 
 import numpy as np
 
+from ._errors import created
 from ._vpds import ffi, lib
 
 __all__ = ["GridSource"]
@@ -143,17 +144,8 @@ class GridSource:
         desc.shape = shape
         desc.values = ffi.cast("const double *", ffi.from_buffer(values))
         desc.lo, desc.hi = lo, hi
-        msg = ffi.new("char[]", 512)
-        st = lib.vpds_grid_validate_window(desc, whole, off, msg, 512)
-        if st != lib.VPDS_OK:
-            from ._core import _raise
-            _raise(st, ffi.string(msg).decode())
-        out = ffi.new("vpds_grid **")
-        st = lib.vpds_grid_create_window(desc, whole, off, out)
-        if st != lib.VPDS_OK:
-            from ._core import _raise
-            _raise(st, "vpds_grid_create_window failed")
-        return ffi.gc(out[0], lib.vpds_grid_destroy)
+        return created(lib.vpds_grid_validate_window, lib.vpds_grid_create_window,
+                       lib.vpds_grid_destroy, "vpds_grid", desc, whole, off)
 
     def stats(self) -> tuple[float, float, float]:
         """(L, min, max) of the whole grid, read in blocks that overlap by one node."""

@@ -14,7 +14,8 @@ from typing import Any, Callable, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
-from ._core import RULES, SizingGrid, _raise, _seed_from
+from ._core import RULES, SizingGrid, _seed_from
+from ._errors import _raise, created
 from ._vpds import ffi, lib
 from .gridsource import GridSource
 
@@ -185,15 +186,8 @@ class Tiling:
         tdesc.tiles = tiles
         tdesc.scale = spec.scale
         tdesc.sizing_per_tile = 1 if isinstance(s, GridSource) else 0
-        msg = ffi.new("char[]", 1024)
-        st = lib.vpds_tiling_validate(tdesc, msg, 1024)
-        if st != lib.VPDS_OK:
-            _raise(st, ffi.string(msg).decode())
-        out = ffi.new("vpds_tiling **")
-        st = lib.vpds_tiling_create(tdesc, out)
-        if st != lib.VPDS_OK:
-            _raise(st, "vpds_tiling_create failed")
-        self._t = ffi.gc(out[0], lib.vpds_tiling_destroy)
+        self._t = created(lib.vpds_tiling_validate, lib.vpds_tiling_create,
+                          lib.vpds_tiling_destroy, "vpds_tiling", tdesc)
 
     # -- the grid of tiles ---------------------------------------------------------------------
     @property
