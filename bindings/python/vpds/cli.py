@@ -9,8 +9,8 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
-from . import analysis
 from ._core import RULES, PoissonDisk, VpdsError
+from ._optional import MissingDependencyError, require
 
 # names a --sizing expression may use, besides x (the coordinates, x[k] the k-th, shape (d, m))
 _EXPR_NAMES = {name: getattr(np, name) for name in (
@@ -70,33 +70,6 @@ def write_points(path: Path, x: np.ndarray, r: np.ndarray, t: np.ndarray, fixed:
             np.savetxt(f, np.column_stack([xyz, r, t]), fmt="%.17g")
     else:
         raise SystemExit(f"vpds sample: -o {path}: use .npy, .npz, .csv or .ply")
-
-
-def plot_points(path: Path, x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                title: str) -> None:
-    """Points with their disks for small n, points alone for large n (the first two axes)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.collections import PatchCollection
-    from matplotlib.patches import Circle
-    fig, ax = plt.subplots(figsize=(7, 7 * (hi[1] - lo[1]) / (hi[0] - lo[0]) if len(lo) > 1 else 2))
-    y = x[:, 1] if x.shape[1] > 1 else np.zeros(len(x))
-    if len(x) <= 5000:
-        disks = PatchCollection([Circle((a, b), rr) for a, b, rr in zip(x[:, 0], y, r)],
-                                facecolor="tab:blue", alpha=0.15, edgecolor="tab:blue", lw=0.3)
-        ax.add_collection(disks)
-        ax.plot(x[:, 0], y, ".", ms=2, color="black")
-    else:
-        ax.plot(x[:, 0], y, ",", color="black")
-    ax.set_xlim(lo[0], hi[0])
-    if x.shape[1] > 1:
-        ax.set_ylim(lo[1], hi[1])
-    ax.set_aspect("equal")
-    ax.set_title(title, fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
 
 
 def domain_from_file(path: Path):
@@ -169,6 +142,7 @@ def cmd_sample(args: argparse.Namespace) -> int:
         write_points(Path(args.output), x, r, t, fixed)
         print(f"wrote {args.output}")
     if args.plot:
+        from .plots import plot_points
         plot_points(Path(args.plot), x, r, lo, hi, f"{len(x)} samples, {what}, {args.rule}")
         print(f"wrote {args.plot}")
     return 0
@@ -197,6 +171,7 @@ def read_points(path: Path):
 
 
 def cmd_analyze(args: argparse.Namespace) -> int:
+    analysis = require("vpds.analysis", "vpds analyze", "scipy")
     x, r, t = read_points(Path(args.file))
     n, dim = x.shape
     lo = _floats(args.lo, dim, 0.0, "--lo")
@@ -244,52 +219,11 @@ def cmd_analyze(args: argparse.Namespace) -> int:
         if not ok:
             failed.append("Table 1 bounds")
     if args.plot:
+        from .plots import plot_analysis
         plot_analysis(Path(args.plot), x, r, lo, hi, report, args.rule, scale * lipschitz, scale)
         print(f"wrote {args.plot}")
     print("all guarantees hold" if not failed else "FAILED: " + ", ".join(failed))
     return 1 if failed else 0
-
-
-def plot_analysis(path: Path, x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                  report, rule: str, lipschitz: float, scale: float) -> None:
-    """One PNG: the points, the periodogram (DC removed), radial mean power, anisotropy, and in
-    2D the Delaunay minimum-angle and edge-ratio histograms with the Table 1 bounds."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(2, 3, figsize=(15, 9.5))
-    ax = axes[0, 0]
-    ax.plot(x[:, 0], x[:, 1] if x.shape[1] > 1 else np.zeros(len(x)), ",", color="black")
-    ax.set_aspect("equal")
-    ax.set_title(f"{len(x)} points")
-    if x.shape[1] >= 2:
-        sp = analysis.spectrum(x, lo, hi)
-        k = sp.frequencies
-        axes[0, 1].imshow(np.log10(sp.power.T + 1e-3), origin="lower", cmap="gray",
-                          extent=[k[0], k[-1], k[0], k[-1]], vmin=-1.5, vmax=1)
-        axes[0, 1].set_title("periodogram, DC removed (log10)")
-        axes[0, 2].plot(sp.radii, sp.radial_mean, lw=1)
-        axes[0, 2].axhline(1, color="gray", lw=0.5)
-        axes[0, 2].set_title("radial mean power")
-        axes[0, 2].set_xlabel("|f|")
-        axes[1, 0].plot(sp.radii, sp.anisotropy_db, lw=1)
-        axes[1, 0].set_ylim(-20, 10)
-        axes[1, 0].set_title("anisotropy (dB)")
-        axes[1, 0].set_xlabel("|f|")
-    if report is not None and x.shape[1] == 2:
-        angles, ratios = analysis.delaunay_histograms(x, r, lo, hi)
-        e_min, e_max, sin_min = analysis.table1_bounds(rule, lipschitz)
-        axes[1, 1].hist(angles, bins=60, color="tab:blue")
-        axes[1, 1].axvline(np.degrees(np.arcsin(sin_min)), color="red", label="Table 1 bound")
-        axes[1, 1].set_title("Delaunay minimum angle (degrees)")
-        axes[1, 1].legend()
-        axes[1, 2].hist(ratios, bins=80, color="tab:blue")
-        for b in (e_min * scale, e_max * scale):
-            axes[1, 2].axvline(b, color="red")
-        axes[1, 2].set_title("Delaunay edge length / r(x), Table 1 bounds")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -350,6 +284,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         print(f"vpds {args.command}: {exc}", file=sys.stderr)
         return 2
     except NotImplementedError as exc:
+        print(f"vpds {args.command}: {exc}", file=sys.stderr)
+        return 2
+    except MissingDependencyError as exc:
         print(f"vpds {args.command}: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
