@@ -27,6 +27,14 @@ FUZZERS := run grid sequence sizing domain
 FUZZ_SECONDS ?= 120
 FUZZ_TEST_SECONDS ?= 30
 FUZZ_FLAGS := -g -O1 -std=c99 -Iinclude -ffp-contract=off -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all
+# The project's Python environment: make demo creates it and installs the package with the demo's
+# extras; make test adds tests/requirements.txt. Nothing goes into the system's Python.
+VENV    ?= $(BUILD)/venv
+PY      := $(VENV)/bin/python
+PIP     := $(PY) -m pip install -q --disable-pip-version-check
+PKG_SRC := bindings/python/pyproject.toml bindings/python/setup.py $(wildcard bindings/python/vpds/*.py) \
+	$(LIB_SRC) $(LIB_HDR)
+
 VALGRIND := valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect
 
 .PHONY: all test demo deps install clean bench check-c check-flann check-py check-sanitizers check-abi \
@@ -102,10 +110,16 @@ check-determinism:
 check-abi: all
 	bash tests/abi_check.sh $(BUILD)
 
+$(PY):
+	bash tools/venv.sh $(VENV)
+
 # the Python binding builds the C library into its extension: one pip install, nothing else
-check-py: $(SAMPLE_TOOL)
-	python3 -m pip install -q --disable-pip-version-check ./bindings/python
-	python3 -m pytest -q tests/py
+$(VENV)/.vpds-installed: $(PKG_SRC) | $(PY)
+	$(PIP) "./bindings/python[demo]"
+	@touch $@
+
+check-py: $(SAMPLE_TOOL) $(VENV)/.vpds-installed
+	$(PY) -m pytest -q tests/py
 
 # The C tests again with AddressSanitizer and UndefinedBehaviorSanitizer (a separate build).
 check-sanitizers:
@@ -113,30 +127,29 @@ check-sanitizers:
 	  CC="$(CC) $(SAN_FLAGS)" check-c
 
 # A fresh machine: install the dependencies once (the stamp remembers), then every check.
-DEPS_STAMP := $(BUILD)/.deps-installed
-$(DEPS_STAMP): tools/deps.sh tests/requirements.txt
-	bash tools/deps.sh
-	@mkdir -p $(BUILD) && touch $@
+DEPS_STAMP := $(VENV)/.deps-installed
+$(DEPS_STAMP): tools/deps.sh tests/requirements.txt | $(PY)
+	bash tools/deps.sh $(PY)
+	@touch $@
 
 test: $(DEPS_STAMP)
 	$(MAKE) --no-print-directory all check-c check-abi check-flann check-sanitizers check-valgrind \
 	  check-determinism check-fuzz check-py
 	@echo "all tests passed"
 
-demo: $(BUILD)/demo/figure1
-	bash tools/demo.sh $(BUILD)
+demo: $(BUILD)/demo/figure1 $(VENV)/.vpds-installed
+	bash tools/demo.sh $(BUILD) $(PY)
 
 $(BUILD)/bench/bench: bench/bench.c $(STATIC)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_TEST) -O2 $< -o $@ $(STATIC) -lm
 
 # Speed and memory beside the peers (installed by the script itself); BENCH_ARGS=--quick for a short run.
-bench: $(BUILD)/bench/bench
-	python3 bench/run.py $(BENCH_ARGS)
-	python3 bench/tiled.py $(if $(findstring --quick,$(BENCH_ARGS)),--quick)
+bench: $(BUILD)/bench/bench $(DEPS_STAMP) $(VENV)/.vpds-installed
+	$(PY) bench/run.py $(BENCH_ARGS)
+	$(PY) bench/tiled.py $(if $(findstring --quick,$(BENCH_ARGS)),--quick)
 
-deps:
-	bash tools/deps.sh
+deps: $(DEPS_STAMP)
 
 install: all
 	install -d $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig
@@ -154,5 +167,5 @@ clean:
 # ---- Tiled sampling on Dask (vpds.distributed): samples/s for 1 and 2 workers, scaling with tiles,
 # peak memory per worker (also the last step of `make bench`); BENCH_ARGS=--quick for a short run.
 .PHONY: bench-tiled
-bench-tiled:
-	python3 bench/tiled.py $(BENCH_ARGS)
+bench-tiled: $(DEPS_STAMP) $(VENV)/.vpds-installed
+	$(PY) bench/tiled.py $(BENCH_ARGS)

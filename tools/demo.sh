@@ -4,25 +4,25 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD=${1:-build}
+# the project's environment, where make demo installed the package with its demo extras
+PY=${2:-$BUILD/venv/bin/python}
 mkdir -p out
 start=$(date +%s)
-python3 -m pip install -q --disable-pip-version-check numpy cffi matplotlib tqdm OpenEXR Pillow
-python3 -m pip install -q --disable-pip-version-check ./bindings/python
 echo "== the C example: $BUILD/demo/figure1 (r = 0.001 + 0.3x, each rule)"
 "$BUILD/demo/figure1" out
 echo "== the vpds command"
 for rule in prior current bigger smaller; do
-  python3 -m vpds sample --sizing "0.001 + 0.3*x[0]" --lipschitz 0.3 --rule "$rule" --seed 2024 \
+  "$PY" -m vpds sample --sizing "0.001 + 0.3*x[0]" --lipschitz 0.3 --rule "$rule" --seed 2024 \
     -o "out/figure1_$rule.npz" --plot "out/figure1_$rule.png" --no-progress
   # the guarantees, checked independently of the C code (exit status 1 if one fails)
-  python3 -m vpds analyze "out/figure1_$rule.npz" --rule "$rule" --sizing "0.001 + 0.3*x[0]" \
+  "$PY" -m vpds analyze "out/figure1_$rule.npz" --rule "$rule" --sizing "0.001 + 0.3*x[0]" \
     --lipschitz 0.3 | tail -1
 done
-python3 -m vpds sample --lo 0.5 --hi 1 --rule bigger --seed 1 --lipschitz 0.3733 --no-progress \
+"$PY" -m vpds sample --lo 0.5 --hi 1 --rule bigger --seed 1 --lipschitz 0.3733 --no-progress \
   --sizing "0.015 + (0.00015 - 0.015)*abs(sin(8*pi*sqrt((x[0]-0.5)**2 + (x[1]-0.5)**2)))" \
   -o out/figure10_quarter.npz --plot out/figure10_quarter.png
 echo "== an image-driven sizing: out/sizing.exr (written here with the OpenEXR package)"
-python3 - <<'PY'
+"$PY" - <<'PY'
 import numpy as np, OpenEXR
 h, w = 128, 128
 y, x = np.mgrid[0:h, 0:w] / 127.0
@@ -33,10 +33,10 @@ for cx in (0.38, 0.62):
 OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage},
              {"Y": OpenEXR.Channel(img.astype(np.float32))}).write("out/sizing.exr")
 PY
-python3 -m vpds sample --sizing-exr out/sizing.exr --exr-range 0.003,0.03 --lipschitz 0.3 \
+"$PY" -m vpds sample --sizing-exr out/sizing.exr --exr-range 0.003,0.03 --lipschitz 0.3 \
   --seed 1 -o out/image.npz --plot out/image.png --no-progress
 echo "== a shaped domain: a star with a round hole painted in out/shape.png, maximal up to its edge"
-python3 - <<'PY'
+"$PY" - <<'PY'
 import math
 from PIL import Image, ImageDraw
 im = Image.new("L", (512, 512), 0)
@@ -47,6 +47,6 @@ draw.polygon(star, fill=255)
 draw.ellipse((206, 206, 306, 306), fill=0)
 im.save("out/shape.png")
 PY
-python3 -m vpds sample --domain out/shape.png --sizing "0.004 + 0.012*x[1]" --lipschitz 0.012 \
+"$PY" -m vpds sample --domain out/shape.png --sizing "0.004 + 0.012*x[1]" --lipschitz 0.012 \
   --seed 3 -o out/domain.npz --plot out/domain.png --no-progress
 echo "demo: wrote out/figure1_<rule>.csv and .png, out/figure10_quarter.npz and .png, out/image.npz and .png, out/domain.npz and .png in $(( $(date +%s) - start )) s"
