@@ -1,5 +1,6 @@
 """The `vpds` command end to end: options, formats, errors, and the independent checks on what
 it writes."""
+import os
 import subprocess
 import sys
 
@@ -44,7 +45,7 @@ def test_sample_formats_and_refine(tmp_path):
     assert np.load(tmp_path / "b.npy").shape[1] == 2
     vpds("sample", "--radius", "0.05", "--seed", "1", "-o", str(tmp_path / "b.ply"), "--no-progress")
     ply = (tmp_path / "b.ply").read_text().splitlines()
-    n = int(ply[3].split()[-1])
+    n = int(next(line for line in ply if line.startswith("element vertex")).split()[-1])
     assert ply[0] == "ply" and "property double radius" in ply and "property double t" in ply
     body = np.loadtxt(ply[ply.index("end_header") + 1:])
     assert body.shape == (n, 5) and np.all(body[:, 2] == 0) and np.all(body[:, 3] == 0.05)
@@ -63,11 +64,11 @@ def test_errors_exit_non_zero_with_the_c_message(tmp_path):
     res = vpds("sample", "--radius", "-1", check=False)
     assert res.returncode == 2 and "desc.radius = -1" in res.stderr
     res = vpds("sample", "--sizing", "0.01 + y", "--lipschitz", "0.1", check=False)
-    assert res.returncode != 0 and "does not evaluate" in res.stderr
+    assert res.returncode == 2 and "unknown name y" in res.stderr
     res = vpds("sample", "--radius", "0", check=False)
     assert res.returncode == 2 and "desc.radius = 0" in res.stderr
     res = vpds("sample", "-o", str(tmp_path / "x.txt"), check=False)
-    assert res.returncode != 0 and ".npy, .npz, .csv or .ply" in res.stderr
+    assert res.returncode == 2 and "unsupported extension '.txt'" in res.stderr
 
 
 def test_analyze_passes_a_sampling_and_fails_a_corrupted_one(tmp_path):
@@ -86,7 +87,7 @@ def test_analyze_passes_a_sampling_and_fails_a_corrupted_one(tmp_path):
              scales=np.delete(z["scales"], 10), fixed=np.delete(z["fixed"], 10))
     res = vpds("analyze", str(gap), "--rule", "current", "--sizing", "0.01 + 0.02*x[0]",
                "--lipschitz", "0.02", check=False)
-    assert res.returncode == 1 and "maximality" in res.stdout and "FAIL" in res.stdout
+    assert res.returncode == 1 and "FAILED: maximality" in res.stdout
     close = tmp_path / "close.npz"
     p = np.vstack([z["points"], z["points"][:1] + 0.001])
     np.savez(close, points=p, radii=0.01 + 0.02 * p[:, 0], scales=np.ones(len(p)),
@@ -106,3 +107,156 @@ def test_spectrum_shows_blue_noise():
     white = C.spectrum(np.random.default_rng(0).random((len(x), 2)), np.zeros(2), np.ones(2))
     assert low < 0.3 and 0.7 < white.radial_mean.mean() < 1.3
     assert np.all(sp.power >= 0) and sp.power[len(sp.frequencies) // 2, len(sp.frequencies) // 2] == 0
+
+
+# -- the command line as a person uses it ---------------------------------------------------------
+
+@pytest.mark.parametrize("args, message", [
+    (["--sizing", "0.01 +", "--lipschitz", "0.1"], "--sizing '0.01 +': not a Python expression"),
+    (["--sizing", "0.01 + foo(x[0])", "--lipschitz", "0.1"], "unknown name foo"),
+    (["--sizing", "0.01 + x[5]", "--lipschitz", "0.1"], "does not evaluate"),
+    (["--sizing", "0*x[0]", "--lipschitz", "0.1"], "gives r = 0.0 at x = 0.5"),
+    (["--lo", "0,a"], "--lo '0,a': expected numbers"),
+    (["--hi", "1,1,1"], "--hi '1,1,1' has 3 values for --dim 2"),
+    (["--lo", "1", "--hi", "0"], "axis 0 has lo = 1 >= hi = 0"),
+    (["--periodic", "7"], "axis 7 is not in 0..1"),
+    (["--domain", "no-such.png"], "--domain no-such.png: no such file"),
+    (["--sizing-exr", "no-such.exr"], "--sizing-exr no-such.exr: no such file"),
+    (["-o", "out.vtk"], "unsupported extension '.vtk'"),
+    (["-o", "no-such-dir/out.npz"], "directory no-such-dir does not exist"),
+    (["--dim", "4", "-o", "out.ply"], ".ply holds up to 3 coordinates"),
+    (["--tiles", "2,x", "-o", "t.zarr"], "--tiles '2,x': expected tile counts"),
+])
+def test_user_mistakes_are_one_line_with_status_2(tmp_path, args, message):
+    res = subprocess.run([sys.executable, "-m", "vpds", "sample", *args, "--no-progress"],
+                         capture_output=True, text=True, cwd=tmp_path)
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert message in res.stderr and "Traceback" not in res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1, res.stderr
+    assert not list(tmp_path.iterdir())  # refused before sampling: nothing written
+
+
+def test_output_extension_is_refused_before_sampling(tmp_path):
+    """A run that would take minutes is refused at once when its output cannot be written."""
+    res = vpds("sample", "--radius", "0.0005", "-o", str(tmp_path / "x.txt"), "--no-progress",
+               check=False)
+    assert res.returncode == 2 and "samples in" not in res.stdout
+
+
+def test_a_run_that_does_not_fit_is_refused_with_its_estimate():
+    res = vpds("sample", "--radius", "2.6e-5", "--no-progress", check=False)
+    assert res.returncode == 2 and "Traceback" not in res.stderr
+    assert "about 1.0" in res.stderr and "e+09 samples" in res.stderr and "--force" in res.stderr
+
+
+def test_estimate_is_close_to_the_count():
+    from vpds.estimate import estimate_run
+    x = vpds_engine(radius=0.01).fill_space()
+    est = estimate_run(2, [0, 0], [1, 1], radius=0.01)
+    assert 0.85 < est.samples / len(x) < 1.15
+    ramp = lambda y: 0.01 + 0.1 * y[:, 0]  # noqa: E731
+    x = vpds_engine(sizing=ramp, lipschitz=0.1).fill_space()
+    assert 0.8 < estimate_run(2, [0, 0], [1, 1], sizing=ramp).samples / len(x) < 1.2
+
+
+def vpds_engine(**kw):
+    import vpds as v
+    return v.PoissonDisk(2, rng=3, progress=False, **kw)
+
+
+def test_help_documents_every_option_with_its_default_and_version():
+    res = vpds("sample", "--help")
+    text = " ".join(res.stdout.split())
+    for option, default in [("--radius", "0.05"), ("--rule", "smaller"), ("--seed", "0"),
+                            ("--inhibition", "1.0"), ("--domain-threshold", "0.5")]:
+        assert option in text and f"(default: {default})" in text, option
+    res = vpds("--version")
+    assert res.stdout.startswith("vpds 1.") and "libvpds" in res.stdout and "C library" in res.stdout
+
+
+def test_analyze_reads_what_sample_recorded(tmp_path):
+    """Without flags, analyze checks against the run's own sizing, rule and box, and judges a
+    stream by the stream's tolerance."""
+    ramp = tmp_path / "ramp.npz"
+    vpds("sample", "--sizing", "0.01 + 0.3*x[0]", "--lipschitz", "0.3", "--rule", "prior",
+         "--lo", "0,-1", "--hi", "1,0", "--seed", "2", "-o", str(ramp), "--no-progress")
+    res = vpds("analyze", str(ramp), check=False)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "rule prior" in res.stdout and "r = 0.01 + 0.3*x[0] (the file)" in res.stdout
+    assert res.stdout.count(" passed  ") == 3 and "all guarantees hold" in res.stdout
+    # a flag overrides the file: the bigger rule's empty disk does not hold for this output
+    assert vpds("analyze", str(ramp), "--rule", "bigger", check=False).returncode == 1
+    for name in ("s.csv", "s.ply", "s.npz"):
+        out = tmp_path / name
+        vpds("sample", "--stream", "500", "--seed", "1", "-o", str(out), "--no-progress")
+        res = vpds("analyze", str(out), check=False)
+        assert res.returncode == 0, res.stdout + res.stderr
+        assert "within the stream's tolerance 1e-05" in res.stdout and "run: stream" in res.stdout
+
+
+def test_analyze_says_what_it_did_not_check(tmp_path):
+    """Radii that vary without r(x): empty disk checked, maximality and Table 1 not (exit 3)."""
+    out = tmp_path / "ramp.npz"
+    vpds("sample", "--sizing", "0.01 + 0.3*x[0]", "--lipschitz", "0.3", "-o", str(out),
+         "--no-progress")
+    z = dict(np.load(out))
+    bare = tmp_path / "bare.npz"
+    np.savez(bare, points=z["points"], radii=z["radii"], scales=z["scales"], fixed=z["fixed"])
+    res = vpds("analyze", str(bare), check=False)
+    assert res.returncode == 3, res.stdout
+    assert "all guarantees hold" not in res.stdout and "not checked: maximality" in res.stdout
+    assert "r(x) is unknown" in res.stdout and "-> OK" not in res.stdout
+    res = vpds("analyze", str(tmp_path / "missing.npz"), check=False)
+    assert res.returncode == 2 and "no such file" in res.stderr
+    np.savez(tmp_path / "other.npz", a=np.zeros(3))
+    res = vpds("analyze", str(tmp_path / "other.npz"), check=False)
+    assert res.returncode == 2 and "no array 'points'" in res.stderr and "Traceback" not in res.stderr
+
+
+def test_ctrl_c_exits_130_and_keeps_the_samples(tmp_path):
+    """SIGINT mid-run: status 130, the samples so far written whole (renamed into place)."""
+    import signal
+    import time
+    out = tmp_path / "big.npz"
+    proc = subprocess.Popen([sys.executable, "-m", "vpds", "sample", "--radius", "0.0002",
+                             "-o", str(out), "--no-progress"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    time.sleep(3)
+    proc.send_signal(signal.SIGINT)
+    stdout, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 130, stdout + stderr
+    assert "interrupted" in stderr and "Traceback" not in stderr
+    z = np.load(out)
+    assert 0 < len(z["points"]) and [p.name for p in tmp_path.iterdir()] == ["big.npz"]
+    res = vpds("analyze", str(out), check=False)
+    assert res.returncode == 3 and "the run was interrupted" in res.stdout
+
+
+def test_sample_and_help_without_scipy_or_matplotlib(tmp_path):
+    """The package, its CLI and `vpds sample` need numpy and cffi alone; a plot or an analysis
+    without their package is one line naming the pip install, status 2."""
+    blocker = tmp_path / "sitecustomize.py"
+    blocker.write_text(
+        "import sys\n"
+        "class Block:\n"
+        "    def find_spec(self, name, path=None, target=None):\n"
+        "        if name.split('.')[0] in ('scipy', 'matplotlib'):\n"
+        "            raise ImportError(f'blocked: {name}')\n"
+        "sys.meta_path.insert(0, Block())\n")
+    env = dict(os.environ, PYTHONPATH=str(tmp_path))
+
+    def run(*args):
+        return subprocess.run([sys.executable, "-m", "vpds", *args], capture_output=True,
+                              text=True, env=env, cwd=tmp_path)
+    res = subprocess.run([sys.executable, "-c", "import vpds, vpds.cli, sys; "
+                          "assert 'scipy' not in sys.modules and 'matplotlib' not in sys.modules"],
+                         capture_output=True, text=True, env=env)
+    assert res.returncode == 0, res.stderr
+    assert run("--help").returncode == 0 and run("sample", "--help").returncode == 0
+    res = run("sample", "--radius", "0.05", "-o", "a.npz", "--no-progress")
+    assert res.returncode == 0 and (tmp_path / "a.npz").exists(), res.stderr
+    res = run("sample", "--radius", "0.05", "--plot", "a.png", "--no-progress")
+    assert res.returncode == 2 and "pip install matplotlib" in res.stderr
+    assert "Traceback" not in res.stderr
+    res = run("analyze", "a.npz")
+    assert res.returncode == 2 and "pip install scipy" in res.stderr and "Traceback" not in res.stderr

@@ -8,6 +8,9 @@ import os
 import signal
 from pathlib import Path
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 from scipy import stats
@@ -272,5 +275,11 @@ def test_cli_tiles(tmp_path, cluster, capsys):
     assert all_bytes(D.TileStore(out)) == all_bytes(ref)
     assert main(argv[:-3] + ["--address", client.scheduler.address, "--seed", "5"]) == 2
     assert "holds another run (different seed)" in capsys.readouterr().err
-    with pytest.raises(SystemExit, match="needs --radius-max"):
-        main(["sample", "--tiles", "2", "--sizing", "0.02 + 0*x[0]", "--lipschitz", "0.1", "-o", str(tmp_path / "x.zarr")])
+    assert main(["sample", "--tiles", "2", "--sizing", "0.02 + 0*x[0]", "--lipschitz", "0.1",
+                 "-o", str(tmp_path / "x.zarr")]) == 2
+    assert "needs --radius-max" in capsys.readouterr().err
+    # vpds analyze reads the store and checks the union in its insertion order
+    res = subprocess.run([sys.executable, "-m", "vpds", "analyze", str(out)], capture_output=True,
+                         text=True)
+    assert res.returncode == 0 and "all guarantees hold" in res.stdout, res.stdout + res.stderr
+    assert "run: tiles" in res.stdout and "radius 0.03" in res.stdout

@@ -9,6 +9,8 @@ from typing import Callable
 
 import numpy as np
 
+from .cli_common import UsageError
+
 
 def add_tile_arguments(s: argparse.ArgumentParser, plain: Callable[[argparse.Namespace], int]) -> None:
     """The tiled form's options on the `sample` parser; runs `plain` when --tiles is absent."""
@@ -25,29 +27,32 @@ def add_tile_arguments(s: argparse.ArgumentParser, plain: Callable[[argparse.Nam
 
 def cmd_sample_tiles(args: argparse.Namespace) -> int:
     from . import distributed
-    from .cli import _floats, sizing_from_expression
+    from .cli_common import floats_arg as _floats, sizing_from_expression
     dim = args.dim
     if not args.output or not args.output.rstrip("/").endswith(".zarr"):
-        raise SystemExit("vpds sample: --tiles writes a Zarr store: give -o NAME.zarr")
+        raise UsageError("--tiles writes a Zarr store: give -o NAME.zarr")
     for flag in ("refine", "stream", "plot"):
         if getattr(args, flag):
-            raise SystemExit(f"vpds sample: --{flag} is not available with --tiles")
-    counts = [int(v) for v in args.tiles.split(",")]
+            raise UsageError(f"--{flag} is not available with --tiles")
+    try:
+        counts = [int(v) for v in args.tiles.split(",")]
+    except ValueError:
+        raise UsageError(f"--tiles {args.tiles!r}: expected tile counts separated by commas") from None
     if len(counts) == 1:
         counts = counts * dim
     if len(counts) != dim:
-        raise SystemExit(f"vpds sample: --tiles has {len(counts)} counts for --dim {dim}")
+        raise UsageError(f"--tiles has {len(counts)} counts for --dim {dim}")
     lo = _floats(args.lo, dim, 0.0, "--lo")
     hi = _floats(args.hi, dim, 1.0, "--hi")
     sizing = None
     if args.sizing:
         if args.radius_max is None:
-            raise SystemExit("vpds sample: --sizing with --tiles needs --radius-max (an upper bound "
+            raise UsageError("--sizing with --tiles needs --radius-max (an upper bound "
                              "of r: it sets the margin the tiles share)")
         sizing = sizing_from_expression(args.sizing, dim)
     elif args.sizing_exr:
         if args.lipschitz is not None:
-            raise SystemExit("vpds sample: --lipschitz smooths an image in memory; with --tiles the "
+            raise UsageError("--lipschitz smooths an image in memory; with --tiles the "
                              "image is read per tile: smooth it first, or run without --tiles")
         exr_range = [float(v) for v in args.exr_range.split(",")] if args.exr_range else None
         sizing = distributed.GridSource(args.sizing_exr, lo, hi, channel=args.channel,
@@ -70,6 +75,11 @@ def cmd_sample_tiles(args: argparse.Namespace) -> int:
         return 2
     seconds = time.perf_counter() - t0
     total = store.total
+    import zarr  # what `vpds analyze` needs beyond the tiling's own record (vpds.files)
+    zarr.open_group(args.output, mode="r+").attrs["vpds_cli"] = {
+        "sizing": args.sizing, "sizing_exr": args.sizing_exr, "rule": args.rule,
+        "inhibition": args.inhibition, "coverage": args.coverage, "mode": "tiles",
+        "complete": True, "lipschitz": args.lipschitz, "seed": args.seed}
     print(f"{total} samples in {dim}D over {int(np.prod(counts))} tiles {tuple(counts)} "
           f"(rule {args.rule}, seed {args.seed}) in {seconds:.3f} s; all tiles complete")
     print(f"wrote {args.output} (read it back with vpds.distributed.TileStore)")
