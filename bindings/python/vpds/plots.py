@@ -225,7 +225,8 @@ def points_figure(x: np.ndarray, r: Optional[np.ndarray], lo: np.ndarray, hi: np
                   dpi: float = 150):
     """The Figure of `vpds sample --plot`: the points coloured by r with a colour bar, their
     disks for small n, a zoom panel on the densest place when the points cannot be told apart
-    (zoom=None: decide; True/False: force), a slice in 3D+, a strip in 1D."""
+    (zoom=None: decide; False: never; True: whenever a window 4x smaller than the box holds the
+    smallest radii), a slice in 3D+, a strip in 1D."""
     view = _View(x, r, lo, hi)
     norm = _norm(view.r_all, view.has_radii)
     if disks is None:
@@ -271,10 +272,10 @@ def points_figure(x: np.ndarray, r: Optional[np.ndarray], lo: np.ndarray, hi: np
         zdisks = last or count <= MAX_DISKS
         _draw_2d(zax, view, norm, lo2=zl, hi2=zh, disks=zdisks,
                  pixels_per_unit=height * 0.85 * dpi / float(zh[0] - zl[0]), dpi=dpi, window=True)
+        factor = float(np.min(side)) / float(zh[0] - zl[0])
         zax.set_title(f"{'zoom on the smallest radii' if last else 'zoom'}: [{zl[0]:.4g}, {zh[0]:.4g}]"
                       f" x [{zl[1]:.4g}, {zh[1]:.4g}],\n{count} points"
-                      f"{' with their disks' if zdisks else ''} ({float(np.min(side)) / float(zh[0] - zl[0]):.0f}x)",
-                      fontsize=8)
+                      f"{' with their disks' if zdisks else ''} ({factor:.0f}x)", fontsize=8)
         _indicate(outer, zax, zl, zh)
         outer = zax
     _colour_bar(fig, list(axes), norm, view)
@@ -321,8 +322,9 @@ def _points_figure_1d(view: _View, norm, title, zoom, disks, dpi):
     if zoom is None:
         zoom = _is_dense(view, pixels_per_unit)
     rows = 2 if zoom and len(view.u) else 1
-    fig = _new_figure(figsize=(12, 1.3 + 1.5 * rows + 0.15 * title.count(" ") / 10), dpi=dpi,
-                      layout="constrained")
+    wrapped = _wrap(title, 160)
+    fig = _new_figure(figsize=(12, 1.1 + 1.5 * rows + 0.2 * max(1, len(wrapped.splitlines()))),
+                      dpi=dpi, layout="constrained")
     axes = fig.subplots(rows, 1, squeeze=False)[:, 0]
     _draw_1d(axes[0], view, norm, lo1=lo1, hi1=hi1, disks=disks)
     axes[0].set_title("all points" + (" (ticks) with their intervals [x - r, x + r] below"
@@ -344,7 +346,7 @@ def _points_figure_1d(view: _View, norm, title, zoom, disks, dpi):
         for spine in axes[1].spines.values():
             spine.set_edgecolor("red")
     _colour_bar(fig, list(axes), norm, view)
-    fig.suptitle(_wrap(title, 140), fontsize=9)
+    fig.suptitle(wrapped, fontsize=9)
     return fig
 
 
