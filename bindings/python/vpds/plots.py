@@ -393,8 +393,9 @@ def analysis_figure(x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np.ndarray
     ppu = 4.3 * 0.85 * dpi / float(hi2[0] - lo2[0])
     _draw_2d(ax, view, norm, lo2=lo2, hi2=hi2, disks=len(view.u) <= MAX_DISKS,
              pixels_per_unit=ppu, dpi=dpi)
-    ax.set_title(view.selection if dim >= 3 else f"{n} points", fontsize=9 if dim < 3 else 7)
+    ax.set_title(view.selection if dim >= 3 else f"{n} points", fontsize=9 if dim < 3 else 8)
     _colour_bar(fig, [ax], norm, view)
+    ax.set_title(_wrap(ax.get_title(), 62), fontsize=ax.title.get_fontsize())
     used = {(0, 0)}
     if dim >= 2 and n >= 2:
         sp = analysis.spectrum(x, lo, hi)
@@ -407,7 +408,7 @@ def analysis_figure(x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np.ndarray
         im = axes[0, 1].imshow(logp, origin="lower", cmap="gray", extent=[k[0], k[-1], k[0], k[-1]],
                                vmin=vmin, vmax=vmax, interpolation="nearest")
         fig.colorbar(im, ax=axes[0, 1], shrink=0.85, pad=0.01, label="log10 power")
-        axes[0, 1].set_title("periodogram, DC removed" + (" (of the points projected on x[0], x[1])"
+        axes[0, 1].set_title("periodogram, DC removed" + ("\n(the points projected on x[0], x[1])"
                                                           if dim > 2 else ""))
         axes[0, 1].set_xlabel("f_x (cycles per box side)")
         axes[0, 1].set_ylabel("f_y (cycles per box side)")
@@ -456,7 +457,8 @@ def analysis_figure(x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np.ndarray
             if (i, j) not in used:
                 axes[i, j].set_axis_off()
                 why = ("the spectrum needs 2 or more points" if (i, j) in ((0, 1), (0, 2), (1, 0))
-                       else "Delaunay histograms: 2D only (and 3 or more points)")
+                       else "Delaunay histograms: 2D only" if dim != 2
+                       else "Delaunay histograms: 3 or more points")
                 axes[i, j].text(0.5, 0.5, why, ha="center", va="center", color="0.4",
                                 transform=axes[i, j].transAxes)
     fig.suptitle(title, fontsize=11)
