@@ -109,6 +109,7 @@ check-determinism:
 
 check-abi: all
 	bash tests/abi_check.sh $(BUILD)
+	bash tests/readme_quickstart.sh $(BUILD)
 
 $(PY):
 	bash tools/venv.sh $(VENV)
@@ -132,10 +133,20 @@ $(DEPS_STAMP): tools/deps.sh tests/requirements.txt | $(PY)
 	bash tools/deps.sh $(PY)
 	@touch $@
 
+# One line per phase (tools/phase.sh: the counts and the time; the log's end when it fails).
+PHASE := bash tools/phase.sh
+SUBMAKE := $(MAKE) --no-print-directory
 test: $(DEPS_STAMP)
-	$(MAKE) --no-print-directory all check-c check-abi check-flann check-sanitizers check-valgrind \
-	  check-determinism check-fuzz check-py
-	@echo "all tests passed"
+	@$(PHASE) build $(SUBMAKE) all $(TEST_BIN) $(FLANN_TEST) $(SAMPLE_TOOL)
+	@$(PHASE) c-tests $(SUBMAKE) check-c
+	@$(PHASE) abi+readme $(SUBMAKE) check-abi
+	@$(PHASE) flann $(SUBMAKE) check-flann
+	@$(PHASE) sanitizers $(SUBMAKE) check-sanitizers
+	@$(PHASE) valgrind $(SUBMAKE) check-valgrind
+	@$(PHASE) determinism $(SUBMAKE) check-determinism
+	@$(PHASE) fuzz $(SUBMAKE) check-fuzz
+	@$(PHASE) python $(SUBMAKE) check-py
+	@echo "all tests passed (logs in build/logs)"
 
 demo: $(BUILD)/demo/figure1 $(VENV)/.vpds-installed
 	bash tools/demo.sh $(BUILD) $(PY)

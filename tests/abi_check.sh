@@ -43,3 +43,4 @@ n_inst=$(LD_LIBRARY_PATH="$tmp/prefix/lib" "$tmp/use_installed")
 [ "$n_inst" = "$n_cpp" ] || fail "installed copy gave $n_inst samples, the build $n_cpp"
 [ -L "$tmp/prefix/lib/libvpds.so.1" ] || fail "libvpds.so.1 not installed"
 echo "make install + pkg-config: built and ran ($n_inst samples)"
+echo "summary: $(echo "$exported" | wc -l) symbols exported, all vpds_*; SONAME $soname; the header as C++; make install + pkg-config"

@@ -6,12 +6,13 @@
 #include <stdlib.h>
 
 static int check_failures = 0;
+static long check_count = 0;
 
-#define CHECK(cond) do { if (!(cond)) { check_failures++; \
+#define CHECK(cond) do { check_count++; if (!(cond)) { check_failures++; \
     fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond); } } while (0)
-#define CHECK_MSG(cond, ...) do { if (!(cond)) { check_failures++; \
+#define CHECK_MSG(cond, ...) do { check_count++; if (!(cond)) { check_failures++; \
     fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, #cond); \
     fprintf(stderr, __VA_ARGS__); fputc('\n', stderr); } } while (0)
 #define CHECK_DONE() do { if (check_failures) { fprintf(stderr, "%d check(s) failed\n", \
-    check_failures); return 1; } printf("ok\n"); return 0; } while (0)
+    check_failures); return 1; } printf("ok: %ld checks\n", check_count); return 0; } while (0)
 #endif

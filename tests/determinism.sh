@@ -43,5 +43,5 @@ if [ "${UPDATE_GOLDEN:-0}" = 1 ]; then cp "$out/actual.sha256" "$golden"; echo "
 if ! diff -u "$golden" "$out/actual.sha256"; then
   echo "determinism: output differs from the golden outputs of algorithm version 1" >&2; status=1
 fi
-[ $status = 0 ] && echo "determinism: ${#configs[@]} configurations, ${#variants[@]} builds each, identical bytes, matching the golden outputs"
+[ $status = 0 ] && echo "summary: ${#configs[@]} configurations, ${#variants[@]} builds each, identical bytes, matching the golden outputs"
 exit $status

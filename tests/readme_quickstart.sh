@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# The README's C quick start compiles as printed (C99, -Wall -Wextra -Wpedantic -Werror) and runs:
+# the first ```c block after "## C quick start", built against the static library.
+set -euo pipefail
+BUILD=${1:-build}
+out="$BUILD/readme"
+mkdir -p "$out"
+awk '/^## C quick start/ {on = 1} on && /^```c$/ {grab = 1; next} grab && /^```$/ {exit}
+     grab {print}' README.md > "$out/quick.c"
+[ -s "$out/quick.c" ] || { echo "readme_quickstart: no C block under '## C quick start'" >&2; exit 1; }
+${CC:-gcc} -std=c99 -Wall -Wextra -Wpedantic -Werror -Iinclude "$out/quick.c" -o "$out/quick" \
+  "$BUILD/libvpds.a" -lm
+line=$("$out/quick")
+echo "$line" | grep -Eq '^[0-9]+ samples; the first at \(' \
+  || { echo "readme_quickstart: unexpected output: $line" >&2; exit 1; }
+echo "summary: the README C quick start compiles with -Werror and runs ($line)"
