@@ -92,15 +92,43 @@ class Progressive(NamedTuple):
     t: float            # the scale reached: the set is maximal at t (the last sample's t)
 
 
+_SEED_LIMIT = 2**64  # ints below are the C seed itself
+
+
 def _seed_from(rng: Any) -> int:
-    """An int is the C seed itself (the same points as the C library); a Generator (or
-    anything numpy.random.default_rng takes) gives a seed drawn from it."""
+    """The C seed of an `rng` (scipy's rule, numpy.random.default_rng, with one exception kept
+    for the C library's sake):
+
+    - an int in [0, 2**64) is the C seed itself (the same points as the C library and the
+      CLI's --seed, whatever the version of numpy);
+    - a larger int goes through numpy.random.SeedSequence as default_rng takes it: the seed is
+      drawn from default_rng(rng), so rng=n and rng=numpy.random.default_rng(n) agree for
+      n >= 2**64 (below, an int is the C seed and a Generator is drawn from: they differ);
+    - a negative int is refused, as default_rng (and so scipy) refuses it;
+    - a Generator (or RandomState) gives a seed drawn from it: the draw consumes its state, so
+      engines made in turn from one generator differ;
+    - None (fresh entropy), a SeedSequence, a BitGenerator or a sequence of ints: the seed
+      is drawn from default_rng(rng).
+    """
     if isinstance(rng, (numbers.Integral, np.integer)) and not isinstance(rng, bool):
         seed = int(rng)
-        if not 0 <= seed < 2**64:
-            raise ValueError(f"rng = {seed}: an int seed must be in [0, 2**64)")
-        return seed
-    gen = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
+        if seed < 0:
+            raise ValueError(f"rng = {seed}: an int seed must be >= 0 (numpy.random.default_rng, "
+                             "and so scipy, refuses negative seeds); an int in [0, 2**64) is the "
+                             "C seed itself, a larger one goes through numpy.random.SeedSequence")
+        if seed < _SEED_LIMIT:
+            return seed
+    if isinstance(rng, np.random.Generator):
+        gen = rng
+    elif isinstance(rng, np.random.RandomState):  # what default_rng does with it (numpy >= 2)
+        gen = np.random.Generator(rng._bit_generator)
+    else:
+        try:
+            gen = np.random.default_rng(rng)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"rng = {rng!r} cannot be used to seed a numpy.random.Generator "
+                             f"instance ({exc}); give an int, None, a Generator, a "
+                             "SeedSequence or a BitGenerator") from None
     return int(gen.integers(0, 2**63, dtype=np.int64))
 
 
@@ -112,6 +140,16 @@ class PoissonDisk:
     `ncandidates` and `optimization` are accepted and have no effect (libvpds is not
     Bridson's algorithm: it throws darts into a hyper-octree of uncovered cells, and its
     process is bias-free and maximal).
+
+      rng:        an int in [0, 2**64) is the C seed itself (the points of the C library and
+                  of `vpds sample --seed`); a larger int goes through numpy.random.SeedSequence
+                  (the seed is drawn from numpy.random.default_rng(rng), so rng=n and
+                  rng=default_rng(n) agree for n >= 2**64); a negative int is refused, as
+                  default_rng refuses it. A Generator or RandomState gives a seed drawn from
+                  it (so engines made in turn from one generator differ), and None, a
+                  SeedSequence or a BitGenerator one drawn from default_rng(rng). `seed` (scipy's
+                  former name) is the same argument: give one of them. The `seed` attribute is
+                  the C seed in use.
 
     Beyond scipy:
       sizing:     None (use `radius`), a float, a numpy grid of radii over the bounds (d axes,
@@ -146,10 +184,13 @@ class PoissonDisk:
                  radius_min: Optional[float] = None, radius_max: Optional[float] = None,
                  fixed_points: Optional[npt.ArrayLike] = None,
                  fixed_radii: Optional[npt.ArrayLike] = None, progress: bool = True,
-                 seed: Optional[int] = None, sizing_channel: Optional[str] = None,
+                 seed: Any = None, sizing_channel: Optional[str] = None,
                  sizing_range: Optional[Sequence[float]] = None,
                  sizing_grid_shape: Optional[Sequence[int]] = None, domain: Any = None,
                  domain_threshold: float = 0.5):
+        if seed is not None and rng is not None:
+            raise TypeError("PoissonDisk() got multiple values for argument now known as `rng`. "
+                            "Specify one of `rng` or `seed`.")
         if hypersphere not in ("volume", "surface"):
             raise ValueError(f"{hypersphere!r} is not a valid hypersphere sampling method. It "
                              "must be one of {'volume', 'surface'} (it has no effect here)")
