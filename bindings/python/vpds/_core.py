@@ -132,14 +132,43 @@ def _seed_from(rng: Any) -> int:
     return int(gen.integers(0, 2**63, dtype=np.int64))
 
 
+def _validate_bounds(l_bounds: Optional[npt.ArrayLike], u_bounds: Optional[npt.ArrayLike],
+                     d: int) -> tuple[np.ndarray, np.ndarray]:
+    """scipy.stats.qmc's rule for bounds (its _validate_bounds, its messages): each broadcast
+    to (d,) (default 0 and 1), l_bounds < u_bounds on every axis; float64 copies."""
+    def values(name: str, v: Optional[npt.ArrayLike], default: float) -> np.ndarray:
+        if v is None:
+            return np.full(d, default)
+        try:
+            return np.asarray(v, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"{name} = {v!r}: must be numbers ({exc})") from None
+    lo, hi = values("l_bounds", l_bounds, 0.0), values("u_bounds", u_bounds, 1.0)
+    try:
+        lower, upper = np.broadcast_to(lo, d).copy(), np.broadcast_to(hi, d).copy()
+    except ValueError:
+        raise ValueError("'l_bounds' and 'u_bounds' must be broadcastable and respect the sample "
+                         f"dimension: l_bounds has shape {lo.shape}, u_bounds {hi.shape}, for "
+                         f"d = {d}") from None
+    # lo against hi as given, too: with d = 0 a broadcast to (0,) would hide l_bounds=[1],
+    # u_bounds=[0] (both broadcast to (d,), so they broadcast to each other)
+    a, b = np.broadcast_arrays(np.atleast_1d(lo), np.atleast_1d(hi))
+    bad = np.flatnonzero(~(a < b))
+    if bad.size:
+        k = int(bad[0])
+        raise ValueError(f"Bounds are not consistent 'l_bounds' < 'u_bounds': l_bounds[{k}] = "
+                         f"{float(a[k])!r}, u_bounds[{k}] = {float(b[k])!r}")
+    return lower, upper
+
+
 class PoissonDisk:
     """Maximal Poisson-disk sampling with spatially varying radii, in any dimension (1 to 8).
 
     A drop-in for ``scipy.stats.qmc.PoissonDisk`` where the arguments overlap (`d`, `radius`,
-    `rng`, `l_bounds`, `u_bounds`, `random(n)`, `fill_space()`, `reset()`); `hypersphere`,
-    `ncandidates` and `optimization` are accepted and have no effect (libvpds is not
-    Bridson's algorithm: it throws darts into a hyper-octree of uncovered cells, and its
-    process is bias-free and maximal).
+    `rng` (or `seed`, not both), `l_bounds`, `u_bounds` (broadcast to (d,), scipy's errors),
+    `random(n)`, `fill_space()`, `reset()`); `hypersphere`, `ncandidates` and `optimization`
+    are accepted and have no effect (libvpds is not Bridson's algorithm: it throws darts into
+    a hyper-octree of uncovered cells, and its process is bias-free and maximal).
 
       rng:        an int in [0, 2**64) is the C seed itself (the points of the C library and
                   of `vpds sample --seed`); a larger int goes through numpy.random.SeedSequence
@@ -150,6 +179,10 @@ class PoissonDisk:
                   SeedSequence or a BitGenerator one drawn from default_rng(rng). `seed` (scipy's
                   former name) is the same argument: give one of them. The `seed` attribute is
                   the C seed in use.
+      d = 0:      as scipy: random(n) gives an array of shape (n, 0) (fill_space() one of shape
+                  (0, 0)) and no C sampler is made (libvpds samples d = 1 to 8); the other
+                  arguments are still checked; sizing, domain, fixed points and periodic axes
+                  are refused, and so are the methods beyond scipy's.
 
     Beyond scipy:
       sizing:     None (use `radius`), a float, a numpy grid of radii over the bounds (d axes,
@@ -191,6 +224,10 @@ class PoissonDisk:
         if seed is not None and rng is not None:
             raise TypeError("PoissonDisk() got multiple values for argument now known as `rng`. "
                             "Specify one of `rng` or `seed`.")
+        if not np.issubdtype(type(d), np.integer) or d < 0:
+            raise ValueError(f"d = {d!r}: d must be a non-negative integer value (libvpds "
+                             "samples d = 1 to 8; d = 0 gives scipy's arrays of shape (n, 0))")
+        self.d = int(d)
         if hypersphere not in ("volume", "surface"):
             raise ValueError(f"{hypersphere!r} is not a valid hypersphere sampling method. It "
                              "must be one of {'volume', 'surface'} (it has no effect here)")
@@ -201,13 +238,14 @@ class PoissonDisk:
             raise ValueError(f"ncandidates = {ncandidates!r}: must be >= 1 (it has no effect here)")
         if rule not in RULES:
             raise ValueError(f"rule = {rule!r}: must be one of {sorted(RULES)}")
-        if not isinstance(d, (numbers.Integral, np.integer)) or isinstance(d, bool):
-            raise TypeError(f"d = {d!r}: must be an int")
-        self.d = int(d)
-        self.l_bounds = np.zeros(self.d) if l_bounds is None else np.asarray(l_bounds, dtype=np.float64).reshape(-1)
-        self.u_bounds = np.ones(self.d) if u_bounds is None else np.asarray(u_bounds, dtype=np.float64).reshape(-1)
-        if self.l_bounds.shape != (self.d,) or self.u_bounds.shape != (self.d,):
-            raise ValueError(f"l_bounds and u_bounds must have {self.d} values each")
+        self.l_bounds, self.u_bounds = _validate_bounds(l_bounds, u_bounds, self.d)
+        if self.d == 0:
+            given = [name for name, v in (("sizing", sizing), ("domain", domain),
+                                          ("fixed_points", fixed_points), ("periodic", periodic),
+                                          ("sizing_grid_shape", sizing_grid_shape)) if v is not None]
+            if given:
+                raise ValueError(f"d = 0: {', '.join(given)} need d >= 1 (d = 0 has no space to "
+                                 "sample: random(n) gives scipy's arrays of shape (n, 0))")
         self.radius = float(radius)
         self.rule = rule
         self.progress = progress
@@ -276,6 +314,13 @@ class PoissonDisk:
             desc.domain_user = self._domain.user
         desc.seed = self._seed
         self._desc = desc
+        if self.d == 0:  # no sampler, but the other fields as C checks them (one axis, [0, 1])
+            stand_in = ffi.new("vpds_desc *", desc[0])
+            stand_in.dim, stand_in.lo, stand_in.hi = 1, ffi.NULL, ffi.NULL
+            msg = ffi.new("char[]", 1024)
+            st = lib.vpds_validate(stand_in, msg, 1024)
+            if st != lib.VPDS_OK:
+                _raise(st, ffi.string(msg).decode())
         self._fixed = None
         if fixed_points is not None:
             fx = np.ascontiguousarray(fixed_points, dtype=np.float64).reshape(-1, self.d)
@@ -288,9 +333,16 @@ class PoissonDisk:
     # -- lifetime -----------------------------------------------------------------------------
     def reset(self) -> "PoissonDisk":
         """Back to the empty sampling (the fixed points kept), with the same seed."""
-        self._s = self._new_sampler(self._desc)
-        self.num_generated = int(lib.vpds_count(self._s))
+        self._s = None if self.d == 0 else self._new_sampler(self._desc)
+        self.num_generated = 0 if self._s is None else int(lib.vpds_count(self._s))
         return self
+
+    def _sampler(self, what: str) -> Any:
+        """The C sampler, or a clear refusal with d = 0 (scipy's case, with no sampler)."""
+        if self._s is None:
+            raise ValueError(f"{what} needs d >= 1: with d = 0 there is no space to sample (only "
+                             "scipy's random(n) of shape (n, 0), fill_space() and reset())")
+        return self._s
 
     def _new_sampler(self, desc: Any) -> Any:
         """A C sampler of desc (refused with the C message), holding the fixed points."""
@@ -347,6 +399,9 @@ class PoissonDisk:
         n = int(n)
         if n < 0:
             raise ValueError(f"n = {n}: must be >= 0")
+        if self._s is None:  # d = 0: scipy's n rows of no coordinates
+            self.num_generated += n
+            return np.empty((n, 0))
         target = self.num_generated + n
         if lib.vpds_count(self._s) < target:
             self._run_until(lambda: lib.vpds_run(self._s), target, "sampling")
@@ -356,7 +411,10 @@ class PoissonDisk:
 
     def fill_space(self) -> np.ndarray:
         """Every remaining sample until the set is maximal (all of them, as scipy's
-        fill_space returns the samples it adds), shape (m, d)."""
+        fill_space returns the samples it adds), shape (m, d). With d = 0 there is nothing
+        to fill: shape (0, 0)."""
+        if self._s is None:
+            return np.empty((0, 0))
         self._run_until(lambda: lib.vpds_run(self._s), None, "filling")
         out = self.points[self.num_generated:]
         self.num_generated += len(out)
@@ -365,7 +423,7 @@ class PoissonDisk:
     def refine(self, t: float) -> np.ndarray:
         """Discrete decrease (Section 4.3): maximal at the smaller scale t; returns the new
         samples."""
-        before = int(lib.vpds_count(self._s))
+        before = int(lib.vpds_count(self._sampler("refine()")))
         first = [True]
 
         def step() -> int:
@@ -379,6 +437,7 @@ class PoissonDisk:
 
     def stream(self, t_min: float = 0.0) -> Iterator[tuple[np.ndarray, float]]:
         """The continuous decrease (Section 4.2): (point, t) one at a time, t non-increasing."""
+        self._sampler("stream()")
         x = ffi.new("double[]", self.d)
         t = ffi.new("double *")
         while True:
@@ -400,6 +459,7 @@ class PoissonDisk:
         n = int(n)
         if n < 0:
             raise ValueError(f"n = {n}: must be >= 0")
+        self._sampler("progressive()")
         desc = ffi.new("vpds_desc *", self._desc[0])
         if inhibition is not None:
             if not 0 < float(inhibition) <= 1:
@@ -424,6 +484,7 @@ class PoissonDisk:
 
     def add_points(self, x: npt.ArrayLike, r: Optional[npt.ArrayLike] = None) -> None:
         """Fixed points now (between runs): objects already placed, t = +inf."""
+        self._sampler("add_points()")
         fx = np.ascontiguousarray(x, dtype=np.float64).reshape(-1, self.d)
         fr = None if r is None else np.ascontiguousarray(r, dtype=np.float64).reshape(-1)
         if fr is not None and fr.shape != (len(fx),):
@@ -434,10 +495,14 @@ class PoissonDisk:
         self.num_generated = int(lib.vpds_count(self._s))
 
     # -- results (copies) -----------------------------------------------------------------------
+    def _count(self) -> int:
+        """Samples held by the C sampler (none with d = 0, which has no sampler)."""
+        return 0 if self._s is None else int(lib.vpds_count(self._s))
+
     @property
     def points(self) -> np.ndarray:
         """All samples so far, insertion order, shape (n, d)."""
-        n = int(lib.vpds_count(self._s))
+        n = self._count()
         if n == 0:
             return np.empty((0, self.d))
         return np.frombuffer(ffi.buffer(lib.vpds_points(self._s), n * self.d * 8),
@@ -446,25 +511,25 @@ class PoissonDisk:
     @property
     def radii(self) -> np.ndarray:
         """r at each sample (unscaled), shape (n,)."""
-        n = int(lib.vpds_count(self._s))
+        n = self._count()
         return np.frombuffer(ffi.buffer(lib.vpds_radii(self._s), n * 8), dtype=np.float64).copy() if n else np.empty(0)
 
     @property
     def scales(self) -> np.ndarray:
         """The scale t at which each sample was inserted (inf for fixed points), shape (n,)."""
-        n = int(lib.vpds_count(self._s))
+        n = self._count()
         return np.frombuffer(ffi.buffer(lib.vpds_scales(self._s), n * 8), dtype=np.float64).copy() if n else np.empty(0)
 
     @property
     def fixed(self) -> np.ndarray:
         """True where the sample is a fixed point, shape (n,)."""
-        n = int(lib.vpds_count(self._s))
+        n = self._count()
         flags = np.frombuffer(ffi.buffer(lib.vpds_flags(self._s), n), dtype=np.uint8) if n else np.empty(0, np.uint8)
         return (flags & 1).astype(bool)
 
     @property
     def stats(self) -> dict:
-        st = lib.vpds_get_stats(self._s)
+        st = lib.vpds_get_stats(self._sampler("stats"))
         return {k: getattr(st, k) for k in ("darts", "accepted", "levels", "peak_active_cells",
                                              "bytes_held", "peak_bytes", "sizing_calls", "delta",
                                              "t", "maximal", "domain_calls")}
