@@ -10,6 +10,7 @@ import numpy.typing as npt
 
 from ._errors import (VpdsDomainError, VpdsError, VpdsSizingError, VpdsStateError,
                       VpdsUnsupportedError, VpdsValueError, _raise, created)
+from ._optional import MissingDependencyError, require
 from ._vpds import ffi, lib
 from .domain import Domain, as_domain
 
@@ -93,6 +94,7 @@ class Progressive(NamedTuple):
 
 
 _SEED_LIMIT = 2**64  # ints below are the C seed itself
+_OPTIMIZATIONS = "{'random-cd', 'lloyd'}"
 
 
 def _seed_from(rng: Any) -> int:
@@ -161,13 +163,39 @@ def _validate_bounds(l_bounds: Optional[npt.ArrayLike], u_bounds: Optional[npt.A
     return lower, upper
 
 
+def _optimization_name(optimization: Optional[str], d: int) -> Optional[str]:
+    """scipy's optimization names, in any case (as its QMCEngine), lower-cased; or None."""
+    if optimization is None:
+        return None
+    name = optimization.lower() if isinstance(optimization, str) else None
+    if name not in ("random-cd", "lloyd"):
+        raise ValueError(f"optimization: {optimization!r} is not a valid optimization method. "
+                         f"It must be one of {_OPTIMIZATIONS} (in any case) or None")
+    if name == "lloyd" and d < 2:
+        raise ValueError(f"optimization = {optimization!r} with d = {d}: Lloyd's Voronoi "
+                         "tessellation needs d >= 2 (scipy refuses it at the first random())")
+    return name
+
+
+def _scipy_optimizers(optimization: str) -> Callable[..., Any]:
+    """scipy.stats.qmc's factory of optimizers (what its QMCEngine calls), imported here."""
+    impl = require("scipy.stats._qmc", f"optimization = {optimization!r} (scipy.stats.qmc's "
+                   "optimizers)", "scipy")
+    select = getattr(impl, "_select_optimizer", None)
+    if select is None:
+        raise MissingDependencyError(f"optimization = {optimization!r} needs scipy >= 1.10 "
+                                     "(pip install 'scipy>=1.10'): this scipy has no "
+                                     "scipy.stats._qmc._select_optimizer")
+    return select  # type: ignore[no-any-return]
+
+
 class PoissonDisk:
     """Maximal Poisson-disk sampling with spatially varying radii, in any dimension (1 to 8).
 
     A drop-in for ``scipy.stats.qmc.PoissonDisk`` where the arguments overlap (`d`, `radius`,
     `rng` (or `seed`, not both), `l_bounds`, `u_bounds` (broadcast to (d,), scipy's errors),
-    `random(n)`, `fill_space()`, `reset()`); `hypersphere`, `ncandidates` and `optimization`
-    are accepted and have no effect (libvpds is not Bridson's algorithm: it throws darts into
+    `optimization`, `random(n)`, `fill_space()`, `reset()`); `hypersphere` and `ncandidates`
+    are checked and have no effect (libvpds is not Bridson's algorithm: it throws darts into
     a hyper-octree of uncovered cells, and its process is bias-free and maximal).
 
       rng:        an int in [0, 2**64) is the C seed itself (the points of the C library and
@@ -183,6 +211,15 @@ class PoissonDisk:
                   (0, 0)) and no C sampler is made (libvpds samples d = 1 to 8); the other
                   arguments are still checked; sizing, domain, fixed points and periodic axes
                   are refused, and so are the methods beyond scipy's.
+      optimization: None, "random-cd" or "lloyd" (in any case), applied as scipy's QMCEngine
+                  does: to each batch random() and fill_space() return, by scipy.stats.qmc's
+                  own optimizers (scipy needed), in the box mapped onto the unit cube. It gives
+                  up the disk guarantee (random-cd swaps coordinates between samples, lloyd
+                  moves them towards Voronoi centroids) and maximality; `points` keeps the
+                  samples as drawn, with the guarantee. Refused with a domain (the moved
+                  samples would leave it); lloyd needs d >= 2 and a batch of more than d
+                  samples (Qhull's tessellation). Its random-cd swaps are drawn from a
+                  Generator seeded with `seed`, restarted by reset().
 
     Beyond scipy:
       sizing:     None (use `radius`), a float, a numpy grid of radii over the bounds (d axes,
@@ -228,12 +265,10 @@ class PoissonDisk:
             raise ValueError(f"d = {d!r}: d must be a non-negative integer value (libvpds "
                              "samples d = 1 to 8; d = 0 gives scipy's arrays of shape (n, 0))")
         self.d = int(d)
+        self.optimization = _optimization_name(optimization, self.d)
         if hypersphere not in ("volume", "surface"):
             raise ValueError(f"{hypersphere!r} is not a valid hypersphere sampling method. It "
                              "must be one of {'volume', 'surface'} (it has no effect here)")
-        if optimization not in (None, "random-cd", "lloyd"):
-            raise ValueError(f"optimization = {optimization!r}: must be None, 'random-cd' or "
-                             "'lloyd' (it has no effect here: the output is maximal already)")
         if int(ncandidates) < 1:
             raise ValueError(f"ncandidates = {ncandidates!r}: must be >= 1 (it has no effect here)")
         if rule not in RULES:
@@ -246,6 +281,12 @@ class PoissonDisk:
             if given:
                 raise ValueError(f"d = 0: {', '.join(given)} need d >= 1 (d = 0 has no space to "
                                  "sample: random(n) gives scipy's arrays of shape (n, 0))")
+        if self.optimization is not None:
+            if domain is not None:
+                raise ValueError(f"optimization = {optimization!r} with a domain: the optimizers "
+                                 "move samples without regard to it (random-cd swaps "
+                                 "coordinates, lloyd moves to centroids in the box)")
+            self._select_optimizer = _scipy_optimizers(optimization)
         self.radius = float(radius)
         self.rule = rule
         self.progress = progress
@@ -335,6 +376,8 @@ class PoissonDisk:
         """Back to the empty sampling (the fixed points kept), with the same seed."""
         self._s = None if self.d == 0 else self._new_sampler(self._desc)
         self.num_generated = 0 if self._s is None else int(lib.vpds_count(self._s))
+        if self.optimization is not None:
+            self._optimizer_rng = np.random.default_rng(self._seed)
         return self
 
     def _sampler(self, what: str) -> Any:
@@ -343,6 +386,30 @@ class PoissonDisk:
             raise ValueError(f"{what} needs d >= 1: with d = 0 there is no space to sample (only "
                              "scipy's random(n) of shape (n, 0), fill_space() and reset())")
         return self._s
+
+    def _optimized(self, sample: np.ndarray) -> np.ndarray:
+        """`sample` through scipy's optimizer (as its QMCEngine.random does), in the box mapped
+        onto the unit cube where scipy's optimizers work; unchanged without optimization."""
+        if self.optimization is None or len(sample) == 0:
+            return sample
+        if self.optimization == "lloyd" and len(sample) <= self.d:
+            raise ValueError(f"optimization = 'lloyd': a batch of {len(sample)} samples in d = "
+                             f"{self.d}; Lloyd's Voronoi tessellation (Qhull) needs more than d. "
+                             "Draw more at once (random(n) with n > d)")
+        config = {"n_nochange": 100, "n_iters": 10_000, "rng": self._optimizer_rng,  # random-cd
+                  "tol": 1e-5, "maxiter": 10, "qhull_options": None}  # lloyd: scipy's own values
+        span = self.u_bounds - self.l_bounds
+        unit = np.clip((sample - self.l_bounds) / span, 0.0, 1.0)
+        moved = np.asarray(self._select_optimizer(self.optimization, config)(unit.copy()))
+        if self.optimization == "random-cd":
+            # it only swaps values within columns: the same swaps of the drawn coordinates,
+            # exactly (mapping back from the unit cube would round some by an ulp)
+            out = np.empty_like(sample)
+            for k in range(self.d):
+                out[np.argsort(moved[:, k], kind="stable"), k] = \
+                    sample[np.argsort(unit[:, k], kind="stable"), k]
+            return out
+        return np.clip(self.l_bounds + moved * span, self.l_bounds, self.u_bounds)
 
     def _new_sampler(self, desc: Any) -> Any:
         """A C sampler of desc (refused with the C message), holding the fixed points."""
@@ -395,7 +462,8 @@ class PoissonDisk:
 
     def random(self, n: int = 1, *, workers: int = 1) -> np.ndarray:
         """The next n samples of the bias-free process (fewer if the set becomes maximal
-        first, as scipy does), shape (n, d). `workers` is accepted for scipy compatibility."""
+        first, as scipy does), shape (n, d), through the `optimization` if one is set.
+        `workers` is accepted for scipy compatibility."""
         n = int(n)
         if n < 0:
             raise ValueError(f"n = {n}: must be >= 0")
@@ -407,18 +475,18 @@ class PoissonDisk:
             self._run_until(lambda: lib.vpds_run(self._s), target, "sampling")
         out = self.points[self.num_generated:target]
         self.num_generated += len(out)
-        return out
+        return self._optimized(out)
 
     def fill_space(self) -> np.ndarray:
         """Every remaining sample until the set is maximal (all of them, as scipy's
-        fill_space returns the samples it adds), shape (m, d). With d = 0 there is nothing
-        to fill: shape (0, 0)."""
+        fill_space returns the samples it adds), shape (m, d), through the `optimization` if
+        one is set. With d = 0 there is nothing to fill: shape (0, 0)."""
         if self._s is None:
             return np.empty((0, 0))
         self._run_until(lambda: lib.vpds_run(self._s), None, "filling")
         out = self.points[self.num_generated:]
         self.num_generated += len(out)
-        return out
+        return self._optimized(out)
 
     def refine(self, t: float) -> np.ndarray:
         """Discrete decrease (Section 4.3): maximal at the smaller scale t; returns the new
@@ -501,7 +569,8 @@ class PoissonDisk:
 
     @property
     def points(self) -> np.ndarray:
-        """All samples so far, insertion order, shape (n, d)."""
+        """All samples so far, insertion order, shape (n, d) (as drawn: before any
+        `optimization`)."""
         n = self._count()
         if n == 0:
             return np.empty((0, self.d))
