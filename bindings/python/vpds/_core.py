@@ -192,11 +192,13 @@ def _scipy_optimizers(optimization: str) -> Callable[..., Any]:
 class PoissonDisk:
     """Maximal Poisson-disk sampling with spatially varying radii, in any dimension (1 to 8).
 
-    A drop-in for ``scipy.stats.qmc.PoissonDisk`` where the arguments overlap (`d`, `radius`,
-    `rng` (or `seed`, not both), `l_bounds`, `u_bounds` (broadcast to (d,), scipy's errors),
-    `optimization`, `random(n)`, `fill_space()`, `reset()`); `hypersphere` and `ncandidates`
-    are checked and have no effect (libvpds is not Bridson's algorithm: it throws darts into
-    a hyper-octree of uncovered cells, and its process is bias-free and maximal).
+    A drop-in for ``scipy.stats.qmc.PoissonDisk`` (scipy's own TestPoisson passes against it:
+    tests/py/test_scipy_suite.py): `d`, `radius`, `rng` (or `seed`, not both), `l_bounds`,
+    `u_bounds` (broadcast to (d,), scipy's errors), `optimization`, `random(n)`,
+    `fill_space()`, `reset()`, `fast_forward(n)`, `integers(...)`, `num_generated`.
+    `hypersphere` and `ncandidates` are checked and have no effect (libvpds is not Bridson's
+    algorithm: it throws darts into a hyper-octree of uncovered cells, and its process is
+    bias-free and maximal).
 
       rng:        an int in [0, 2**64) is the C seed itself (the points of the C library and
                   of `vpds sample --seed`); a larger int goes through numpy.random.SeedSequence
@@ -460,10 +462,10 @@ class PoissonDisk:
             if bar is not None:
                 bar.close()
 
-    def random(self, n: int = 1, *, workers: int = 1) -> np.ndarray:
-        """The next n samples of the bias-free process (fewer if the set becomes maximal
-        first, as scipy does), shape (n, d), through the `optimization` if one is set.
-        `workers` is accepted for scipy compatibility."""
+    def _draw(self, n: Union[int, float]) -> np.ndarray:
+        """The next n samples as drawn (fewer if the set becomes maximal first)."""
+        if isinstance(n, (float, np.floating)) and not float(n).is_integer():
+            raise ValueError(f"n = {n!r}: must be an integer number of samples (or inf)")
         n = int(n)
         if n < 0:
             raise ValueError(f"n = {n}: must be >= 0")
@@ -475,7 +477,16 @@ class PoissonDisk:
             self._run_until(lambda: lib.vpds_run(self._s), target, "sampling")
         out = self.points[self.num_generated:target]
         self.num_generated += len(out)
-        return self._optimized(out)
+        return out
+
+    def random(self, n: Union[int, float] = 1, *, workers: int = 1) -> np.ndarray:
+        """The next n samples of the bias-free process (fewer if the set becomes maximal
+        first, as scipy does), shape (n, d), through the `optimization` if one is set.
+        n = inf is fill_space() (scipy's fill_space is random(inf)). `workers` is accepted
+        for scipy compatibility."""
+        if isinstance(n, (float, np.floating)) and float(n) == float("inf"):
+            return self.fill_space()
+        return self._optimized(self._draw(n))
 
     def fill_space(self) -> np.ndarray:
         """Every remaining sample until the set is maximal (all of them, as scipy's
@@ -487,6 +498,32 @@ class PoissonDisk:
         out = self.points[self.num_generated:]
         self.num_generated += len(out)
         return self._optimized(out)
+
+    def fast_forward(self, n: int) -> "PoissonDisk":
+        """Skip the next n samples (scipy's fast_forward: random(n) discarded, here without
+        the optimizer's work): random(a) then random(b) after fast_forward(k) gives the
+        samples a random(a + k + b) would (without optimization)."""
+        self._draw(n)
+        return self
+
+    def integers(self, l_bounds: npt.ArrayLike, *, u_bounds: Optional[npt.ArrayLike] = None,
+                 n: int = 1, endpoint: bool = False, workers: int = 1) -> np.ndarray:
+        """scipy's QMCEngine.integers: random(n) mapped from the box onto integers in
+        [l_bounds, u_bounds) ([l_bounds, u_bounds] with endpoint; l_bounds 0 when u_bounds is
+        None) by floor of the affine map, shape (n, d), int64. A sample on the box's upper
+        face (the box is closed, scipy's unit cube is not) gives u_bounds - 1."""
+        if u_bounds is None:
+            u_bounds, l_bounds = l_bounds, 0
+        lo, hi = np.atleast_1d(l_bounds), np.atleast_1d(u_bounds)
+        if endpoint:
+            hi = hi + 1
+        if not (np.issubdtype(lo.dtype, np.integer) and np.issubdtype(hi.dtype, np.integer)):
+            raise ValueError("'u_bounds' and 'l_bounds' must be integers or array-like of "
+                             f"integers: l_bounds = {l_bounds!r}, u_bounds = {u_bounds!r}")
+        lower, upper = _validate_bounds(lo, hi, self.d)
+        sample = self.random(n, workers=workers)
+        unit = (sample - self.l_bounds) / (self.u_bounds - self.l_bounds)
+        return np.minimum(np.floor(unit * (upper - lower) + lower), upper - 1).astype(np.int64)
 
     def refine(self, t: float) -> np.ndarray:
         """Discrete decrease (Section 4.3): maximal at the smaller scale t; returns the new
