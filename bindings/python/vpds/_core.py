@@ -288,7 +288,7 @@ class PoissonDisk:
                 raise ValueError(f"optimization = {optimization!r} with a domain: the optimizers "
                                  "move samples without regard to it (random-cd swaps "
                                  "coordinates, lloyd moves to centroids in the box)")
-            self._select_optimizer = _scipy_optimizers(optimization)
+            self._select_optimizer = _scipy_optimizers(self.optimization)
         self.radius = float(radius)
         self.rule = rule
         self.progress = progress
