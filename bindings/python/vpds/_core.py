@@ -648,5 +648,5 @@ class PoissonDisk:
 
     @property
     def seed(self) -> int:
-        """The C seed in use (an int rng is used as is)."""
+        """The C seed in use (an int rng below 2**64 is used as is)."""
         return self._seed
