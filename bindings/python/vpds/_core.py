@@ -10,6 +10,7 @@ import numpy.typing as npt
 
 from ._errors import (VpdsDomainError, VpdsError, VpdsSizingError, VpdsStateError,
                       VpdsUnsupportedError, VpdsValueError, _raise, created)
+from ._optional import MissingDependencyError, require
 from ._vpds import ffi, lib
 from .domain import Domain, as_domain
 
@@ -92,26 +93,135 @@ class Progressive(NamedTuple):
     t: float            # the scale reached: the set is maximal at t (the last sample's t)
 
 
+_SEED_LIMIT = 2**64  # ints below are the C seed itself
+_OPTIMIZATIONS = "{'random-cd', 'lloyd'}"
+
+
 def _seed_from(rng: Any) -> int:
-    """An int is the C seed itself (the same points as the C library); a Generator (or
-    anything numpy.random.default_rng takes) gives a seed drawn from it."""
+    """The C seed of an `rng` (scipy's rule, numpy.random.default_rng, with one exception kept
+    for the C library's sake):
+
+    - an int in [0, 2**64) is the C seed itself (the same points as the C library and the
+      CLI's --seed, whatever the version of numpy);
+    - a larger int goes through numpy.random.SeedSequence as default_rng takes it: the seed is
+      drawn from default_rng(rng), so rng=n and rng=numpy.random.default_rng(n) agree for
+      n >= 2**64 (below, an int is the C seed and a Generator is drawn from: they differ);
+    - a negative int is refused, as default_rng (and so scipy) refuses it;
+    - a Generator (or RandomState) gives a seed drawn from it: the draw consumes its state, so
+      engines made in turn from one generator differ;
+    - None (fresh entropy), a SeedSequence, a BitGenerator or a sequence of ints: the seed
+      is drawn from default_rng(rng).
+    """
     if isinstance(rng, (numbers.Integral, np.integer)) and not isinstance(rng, bool):
         seed = int(rng)
-        if not 0 <= seed < 2**64:
-            raise ValueError(f"rng = {seed}: an int seed must be in [0, 2**64)")
-        return seed
-    gen = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
+        if seed < 0:
+            raise ValueError(f"rng = {seed}: an int seed must be >= 0 (numpy.random.default_rng, "
+                             "and so scipy, refuses negative seeds); an int in [0, 2**64) is the "
+                             "C seed itself, a larger one goes through numpy.random.SeedSequence")
+        if seed < _SEED_LIMIT:
+            return seed
+    if isinstance(rng, np.random.Generator):
+        gen = rng
+    elif isinstance(rng, np.random.RandomState):  # what default_rng does with it (numpy >= 2)
+        gen = np.random.Generator(rng._bit_generator)
+    else:
+        try:
+            gen = np.random.default_rng(rng)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"rng = {rng!r} cannot be used to seed a numpy.random.Generator "
+                             f"instance ({exc}); give an int, None, a Generator, a "
+                             "SeedSequence or a BitGenerator") from None
     return int(gen.integers(0, 2**63, dtype=np.int64))
+
+
+def _validate_bounds(l_bounds: Optional[npt.ArrayLike], u_bounds: Optional[npt.ArrayLike],
+                     d: int) -> tuple[np.ndarray, np.ndarray]:
+    """scipy.stats.qmc's rule for bounds (its _validate_bounds, its messages): each broadcast
+    to (d,) (default 0 and 1), l_bounds < u_bounds on every axis; float64 copies."""
+    def values(name: str, v: Optional[npt.ArrayLike], default: float) -> np.ndarray:
+        if v is None:
+            return np.full(d, default)
+        try:
+            return np.asarray(v, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"{name} = {v!r}: must be numbers ({exc})") from None
+    lo, hi = values("l_bounds", l_bounds, 0.0), values("u_bounds", u_bounds, 1.0)
+    try:
+        lower, upper = np.broadcast_to(lo, d).copy(), np.broadcast_to(hi, d).copy()
+    except ValueError:
+        raise ValueError("'l_bounds' and 'u_bounds' must be broadcastable and respect the sample "
+                         f"dimension: l_bounds has shape {lo.shape}, u_bounds {hi.shape}, for "
+                         f"d = {d}") from None
+    # lo against hi as given, too: with d = 0 a broadcast to (0,) would hide l_bounds=[1],
+    # u_bounds=[0] (both broadcast to (d,), so they broadcast to each other)
+    a, b = np.broadcast_arrays(np.atleast_1d(lo), np.atleast_1d(hi))
+    bad = np.flatnonzero(~(a < b))
+    if bad.size:
+        k = int(bad[0])
+        raise ValueError(f"Bounds are not consistent 'l_bounds' < 'u_bounds': l_bounds[{k}] = "
+                         f"{float(a[k])!r}, u_bounds[{k}] = {float(b[k])!r}")
+    return lower, upper
+
+
+def _optimization_name(optimization: Optional[str], d: int) -> Optional[str]:
+    """scipy's optimization names, in any case (as its QMCEngine), lower-cased; or None."""
+    if optimization is None:
+        return None
+    name = optimization.lower() if isinstance(optimization, str) else None
+    if name not in ("random-cd", "lloyd"):
+        raise ValueError(f"optimization: {optimization!r} is not a valid optimization method. "
+                         f"It must be one of {_OPTIMIZATIONS} (in any case) or None")
+    if name == "lloyd" and d < 2:
+        raise ValueError(f"optimization = {optimization!r} with d = {d}: Lloyd's Voronoi "
+                         "tessellation needs d >= 2 (scipy refuses it at the first random())")
+    return name
+
+
+def _scipy_optimizers(optimization: str) -> Callable[..., Any]:
+    """scipy.stats.qmc's factory of optimizers (what its QMCEngine calls), imported here."""
+    impl = require("scipy.stats._qmc", f"optimization = {optimization!r} (scipy.stats.qmc's "
+                   "optimizers)", "scipy")
+    select = getattr(impl, "_select_optimizer", None)
+    if select is None:
+        raise MissingDependencyError(f"optimization = {optimization!r} needs scipy >= 1.10 "
+                                     "(pip install 'scipy>=1.10'): this scipy has no "
+                                     "scipy.stats._qmc._select_optimizer")
+    return select  # type: ignore[no-any-return]
 
 
 class PoissonDisk:
     """Maximal Poisson-disk sampling with spatially varying radii, in any dimension (1 to 8).
 
-    A drop-in for ``scipy.stats.qmc.PoissonDisk`` where the arguments overlap (`d`, `radius`,
-    `rng`, `l_bounds`, `u_bounds`, `random(n)`, `fill_space()`, `reset()`); `hypersphere`,
-    `ncandidates` and `optimization` are accepted and have no effect (libvpds is not
-    Bridson's algorithm: it throws darts into a hyper-octree of uncovered cells, and its
-    process is bias-free and maximal).
+    A drop-in for ``scipy.stats.qmc.PoissonDisk`` (scipy's own TestPoisson passes against it:
+    tests/py/test_scipy_suite.py): `d`, `radius`, `rng` (or `seed`, not both), `l_bounds`,
+    `u_bounds` (broadcast to (d,), scipy's errors), `optimization`, `random(n)`,
+    `fill_space()`, `reset()`, `fast_forward(n)`, `integers(...)`, `num_generated`.
+    `hypersphere` and `ncandidates` are checked and have no effect (libvpds is not Bridson's
+    algorithm: it throws darts into a hyper-octree of uncovered cells, and its process is
+    bias-free and maximal).
+
+      rng:        an int in [0, 2**64) is the C seed itself (the points of the C library and
+                  of `vpds sample --seed`); a larger int goes through numpy.random.SeedSequence
+                  (the seed is drawn from numpy.random.default_rng(rng), so rng=n and
+                  rng=default_rng(n) agree for n >= 2**64); a negative int is refused, as
+                  default_rng refuses it. A Generator or RandomState gives a seed drawn from
+                  it (so engines made in turn from one generator differ), and None, a
+                  SeedSequence or a BitGenerator one drawn from default_rng(rng). `seed` (scipy's
+                  former name) is the same argument: give one of them. The `seed` attribute is
+                  the C seed in use.
+      d = 0:      as scipy: random(n) gives an array of shape (n, 0) (fill_space() one of shape
+                  (0, 0)) and no C sampler is made (libvpds samples d = 1 to 8); the other
+                  arguments are still checked; sizing, domain, fixed points and periodic axes
+                  are refused, and so are the methods beyond scipy's.
+      optimization: None, "random-cd" or "lloyd" (in any case), applied as scipy's QMCEngine
+                  does: to each batch random() and fill_space() return, by scipy.stats.qmc's
+                  own optimizers (scipy needed), in the box mapped onto the unit cube. It gives
+                  up the disk guarantee (random-cd swaps coordinates between samples, lloyd
+                  moves them towards Voronoi centroids) and maximality; `points` keeps the
+                  samples as drawn, with the guarantee. Refused with a domain (the moved
+                  samples would leave it); lloyd needs d >= 2 and a batch of more than d
+                  samples (Qhull's tessellation). Its random-cd swaps are drawn from a
+                  Generator seeded with `seed`, restarted by reset().
 
     Beyond scipy:
       sizing:     None (use `radius`), a float, a numpy grid of radii over the bounds (d axes,
@@ -146,27 +256,39 @@ class PoissonDisk:
                  radius_min: Optional[float] = None, radius_max: Optional[float] = None,
                  fixed_points: Optional[npt.ArrayLike] = None,
                  fixed_radii: Optional[npt.ArrayLike] = None, progress: bool = True,
-                 seed: Optional[int] = None, sizing_channel: Optional[str] = None,
+                 seed: Any = None, sizing_channel: Optional[str] = None,
                  sizing_range: Optional[Sequence[float]] = None,
                  sizing_grid_shape: Optional[Sequence[int]] = None, domain: Any = None,
                  domain_threshold: float = 0.5):
+        if seed is not None and rng is not None:
+            raise TypeError("PoissonDisk() got multiple values for argument now known as `rng`. "
+                            "Specify one of `rng` or `seed`.")
+        if not np.issubdtype(type(d), np.integer) or d < 0:
+            raise ValueError(f"d = {d!r}: d must be a non-negative integer value (libvpds "
+                             "samples d = 1 to 8; d = 0 gives scipy's arrays of shape (n, 0))")
+        self.d = int(d)
+        self.optimization = _optimization_name(optimization, self.d)
         if hypersphere not in ("volume", "surface"):
             raise ValueError(f"{hypersphere!r} is not a valid hypersphere sampling method. It "
                              "must be one of {'volume', 'surface'} (it has no effect here)")
-        if optimization not in (None, "random-cd", "lloyd"):
-            raise ValueError(f"optimization = {optimization!r}: must be None, 'random-cd' or "
-                             "'lloyd' (it has no effect here: the output is maximal already)")
         if int(ncandidates) < 1:
             raise ValueError(f"ncandidates = {ncandidates!r}: must be >= 1 (it has no effect here)")
         if rule not in RULES:
             raise ValueError(f"rule = {rule!r}: must be one of {sorted(RULES)}")
-        if not isinstance(d, (numbers.Integral, np.integer)) or isinstance(d, bool):
-            raise TypeError(f"d = {d!r}: must be an int")
-        self.d = int(d)
-        self.l_bounds = np.zeros(self.d) if l_bounds is None else np.asarray(l_bounds, dtype=np.float64).reshape(-1)
-        self.u_bounds = np.ones(self.d) if u_bounds is None else np.asarray(u_bounds, dtype=np.float64).reshape(-1)
-        if self.l_bounds.shape != (self.d,) or self.u_bounds.shape != (self.d,):
-            raise ValueError(f"l_bounds and u_bounds must have {self.d} values each")
+        self.l_bounds, self.u_bounds = _validate_bounds(l_bounds, u_bounds, self.d)
+        if self.d == 0:
+            given = [name for name, v in (("sizing", sizing), ("domain", domain),
+                                          ("fixed_points", fixed_points), ("periodic", periodic),
+                                          ("sizing_grid_shape", sizing_grid_shape)) if v is not None]
+            if given:
+                raise ValueError(f"d = 0: {', '.join(given)} need d >= 1 (d = 0 has no space to "
+                                 "sample: random(n) gives scipy's arrays of shape (n, 0))")
+        if self.optimization is not None:
+            if domain is not None:
+                raise ValueError(f"optimization = {optimization!r} with a domain: the optimizers "
+                                 "move samples without regard to it (random-cd swaps "
+                                 "coordinates, lloyd moves to centroids in the box)")
+            self._select_optimizer = _scipy_optimizers(self.optimization)
         self.radius = float(radius)
         self.rule = rule
         self.progress = progress
@@ -235,6 +357,13 @@ class PoissonDisk:
             desc.domain_user = self._domain.user
         desc.seed = self._seed
         self._desc = desc
+        if self.d == 0:  # no sampler, but the other fields as C checks them (one axis, [0, 1])
+            stand_in = ffi.new("vpds_desc *", desc[0])
+            stand_in.dim, stand_in.lo, stand_in.hi = 1, ffi.NULL, ffi.NULL
+            msg = ffi.new("char[]", 1024)
+            st = lib.vpds_validate(stand_in, msg, 1024)
+            if st != lib.VPDS_OK:
+                _raise(st, ffi.string(msg).decode())
         self._fixed = None
         if fixed_points is not None:
             fx = np.ascontiguousarray(fixed_points, dtype=np.float64).reshape(-1, self.d)
@@ -247,9 +376,42 @@ class PoissonDisk:
     # -- lifetime -----------------------------------------------------------------------------
     def reset(self) -> "PoissonDisk":
         """Back to the empty sampling (the fixed points kept), with the same seed."""
-        self._s = self._new_sampler(self._desc)
-        self.num_generated = int(lib.vpds_count(self._s))
+        self._s = None if self.d == 0 else self._new_sampler(self._desc)
+        self.num_generated = 0 if self._s is None else int(lib.vpds_count(self._s))
+        if self.optimization is not None:
+            self._optimizer_rng = np.random.default_rng(self._seed)
         return self
+
+    def _sampler(self, what: str) -> Any:
+        """The C sampler, or a clear refusal with d = 0 (scipy's case, with no sampler)."""
+        if self._s is None:
+            raise ValueError(f"{what} needs d >= 1: with d = 0 there is no space to sample (only "
+                             "scipy's random(n) of shape (n, 0), fill_space() and reset())")
+        return self._s
+
+    def _optimized(self, sample: np.ndarray) -> np.ndarray:
+        """`sample` through scipy's optimizer (as its QMCEngine.random does), in the box mapped
+        onto the unit cube where scipy's optimizers work; unchanged without optimization."""
+        if self.optimization is None or len(sample) == 0:
+            return sample
+        if self.optimization == "lloyd" and len(sample) <= self.d:
+            raise ValueError(f"optimization = 'lloyd': a batch of {len(sample)} samples in d = "
+                             f"{self.d}; Lloyd's Voronoi tessellation (Qhull) needs more than d. "
+                             "Draw more at once (random(n) with n > d)")
+        config = {"n_nochange": 100, "n_iters": 10_000, "rng": self._optimizer_rng,  # random-cd
+                  "tol": 1e-5, "maxiter": 10, "qhull_options": None}  # lloyd: scipy's own values
+        span = self.u_bounds - self.l_bounds
+        unit = np.clip((sample - self.l_bounds) / span, 0.0, 1.0)
+        moved = np.asarray(self._select_optimizer(self.optimization, config)(unit.copy()))
+        if self.optimization == "random-cd":
+            # it only swaps values within columns: the same swaps of the drawn coordinates,
+            # exactly (mapping back from the unit cube would round some by an ulp)
+            out = np.empty_like(sample)
+            for k in range(self.d):
+                out[np.argsort(moved[:, k], kind="stable"), k] = \
+                    sample[np.argsort(unit[:, k], kind="stable"), k]
+            return out
+        return np.clip(self.l_bounds + moved * span, self.l_bounds, self.u_bounds)
 
     def _new_sampler(self, desc: Any) -> Any:
         """A C sampler of desc (refused with the C message), holding the fixed points."""
@@ -300,12 +462,16 @@ class PoissonDisk:
             if bar is not None:
                 bar.close()
 
-    def random(self, n: int = 1, *, workers: int = 1) -> np.ndarray:
-        """The next n samples of the bias-free process (fewer if the set becomes maximal
-        first, as scipy does), shape (n, d). `workers` is accepted for scipy compatibility."""
+    def _draw(self, n: Union[int, float]) -> np.ndarray:
+        """The next n samples as drawn (fewer if the set becomes maximal first)."""
+        if isinstance(n, (float, np.floating)) and not float(n).is_integer():
+            raise ValueError(f"n = {n!r}: must be an integer number of samples (or inf)")
         n = int(n)
         if n < 0:
             raise ValueError(f"n = {n}: must be >= 0")
+        if self._s is None:  # d = 0: scipy's n rows of no coordinates
+            self.num_generated += n
+            return np.empty((n, 0))
         target = self.num_generated + n
         if lib.vpds_count(self._s) < target:
             self._run_until(lambda: lib.vpds_run(self._s), target, "sampling")
@@ -313,18 +479,56 @@ class PoissonDisk:
         self.num_generated += len(out)
         return out
 
+    def random(self, n: Union[int, float] = 1, *, workers: int = 1) -> np.ndarray:
+        """The next n samples of the bias-free process (fewer if the set becomes maximal
+        first, as scipy does), shape (n, d), through the `optimization` if one is set.
+        n = inf is fill_space() (scipy's fill_space is random(inf)). `workers` is accepted
+        for scipy compatibility."""
+        if isinstance(n, (float, np.floating)) and float(n) == float("inf"):
+            return self.fill_space()
+        return self._optimized(self._draw(n))
+
     def fill_space(self) -> np.ndarray:
         """Every remaining sample until the set is maximal (all of them, as scipy's
-        fill_space returns the samples it adds), shape (m, d)."""
+        fill_space returns the samples it adds), shape (m, d), through the `optimization` if
+        one is set. With d = 0 there is nothing to fill: shape (0, 0)."""
+        if self._s is None:
+            return np.empty((0, 0))
         self._run_until(lambda: lib.vpds_run(self._s), None, "filling")
         out = self.points[self.num_generated:]
         self.num_generated += len(out)
-        return out
+        return self._optimized(out)
+
+    def fast_forward(self, n: int) -> "PoissonDisk":
+        """Skip the next n samples (scipy's fast_forward: random(n) discarded, here without
+        the optimizer's work): random(a) then random(b) after fast_forward(k) gives the
+        samples a random(a + k + b) would (without optimization)."""
+        self._draw(n)
+        return self
+
+    def integers(self, l_bounds: npt.ArrayLike, *, u_bounds: Optional[npt.ArrayLike] = None,
+                 n: int = 1, endpoint: bool = False, workers: int = 1) -> np.ndarray:
+        """scipy's QMCEngine.integers: random(n) mapped from the box onto integers in
+        [l_bounds, u_bounds) ([l_bounds, u_bounds] with endpoint; l_bounds 0 when u_bounds is
+        None) by floor of the affine map, shape (n, d), int64. A sample on the box's upper
+        face (the box is closed, scipy's unit cube is not) gives u_bounds - 1."""
+        if u_bounds is None:
+            u_bounds, l_bounds = l_bounds, 0
+        lo, hi = np.atleast_1d(l_bounds), np.atleast_1d(u_bounds)
+        if endpoint:
+            hi = hi + 1
+        if not (np.issubdtype(lo.dtype, np.integer) and np.issubdtype(hi.dtype, np.integer)):
+            raise ValueError("'u_bounds' and 'l_bounds' must be integers or array-like of "
+                             f"integers: l_bounds = {l_bounds!r}, u_bounds = {u_bounds!r}")
+        lower, upper = _validate_bounds(lo, hi, self.d)
+        sample = self.random(n, workers=workers)
+        unit = (sample - self.l_bounds) / (self.u_bounds - self.l_bounds)
+        return np.minimum(np.floor(unit * (upper - lower) + lower), upper - 1).astype(np.int64)
 
     def refine(self, t: float) -> np.ndarray:
         """Discrete decrease (Section 4.3): maximal at the smaller scale t; returns the new
         samples."""
-        before = int(lib.vpds_count(self._s))
+        before = int(lib.vpds_count(self._sampler("refine()")))
         first = [True]
 
         def step() -> int:
@@ -338,6 +542,7 @@ class PoissonDisk:
 
     def stream(self, t_min: float = 0.0) -> Iterator[tuple[np.ndarray, float]]:
         """The continuous decrease (Section 4.2): (point, t) one at a time, t non-increasing."""
+        self._sampler("stream()")
         x = ffi.new("double[]", self.d)
         t = ffi.new("double *")
         while True:
@@ -359,6 +564,7 @@ class PoissonDisk:
         n = int(n)
         if n < 0:
             raise ValueError(f"n = {n}: must be >= 0")
+        self._sampler("progressive()")
         desc = ffi.new("vpds_desc *", self._desc[0])
         if inhibition is not None:
             if not 0 < float(inhibition) <= 1:
@@ -383,6 +589,7 @@ class PoissonDisk:
 
     def add_points(self, x: npt.ArrayLike, r: Optional[npt.ArrayLike] = None) -> None:
         """Fixed points now (between runs): objects already placed, t = +inf."""
+        self._sampler("add_points()")
         fx = np.ascontiguousarray(x, dtype=np.float64).reshape(-1, self.d)
         fr = None if r is None else np.ascontiguousarray(r, dtype=np.float64).reshape(-1)
         if fr is not None and fr.shape != (len(fx),):
@@ -393,10 +600,15 @@ class PoissonDisk:
         self.num_generated = int(lib.vpds_count(self._s))
 
     # -- results (copies) -----------------------------------------------------------------------
+    def _count(self) -> int:
+        """Samples held by the C sampler (none with d = 0, which has no sampler)."""
+        return 0 if self._s is None else int(lib.vpds_count(self._s))
+
     @property
     def points(self) -> np.ndarray:
-        """All samples so far, insertion order, shape (n, d)."""
-        n = int(lib.vpds_count(self._s))
+        """All samples so far, insertion order, shape (n, d) (as drawn: before any
+        `optimization`)."""
+        n = self._count()
         if n == 0:
             return np.empty((0, self.d))
         return np.frombuffer(ffi.buffer(lib.vpds_points(self._s), n * self.d * 8),
@@ -405,25 +617,25 @@ class PoissonDisk:
     @property
     def radii(self) -> np.ndarray:
         """r at each sample (unscaled), shape (n,)."""
-        n = int(lib.vpds_count(self._s))
+        n = self._count()
         return np.frombuffer(ffi.buffer(lib.vpds_radii(self._s), n * 8), dtype=np.float64).copy() if n else np.empty(0)
 
     @property
     def scales(self) -> np.ndarray:
         """The scale t at which each sample was inserted (inf for fixed points), shape (n,)."""
-        n = int(lib.vpds_count(self._s))
+        n = self._count()
         return np.frombuffer(ffi.buffer(lib.vpds_scales(self._s), n * 8), dtype=np.float64).copy() if n else np.empty(0)
 
     @property
     def fixed(self) -> np.ndarray:
         """True where the sample is a fixed point, shape (n,)."""
-        n = int(lib.vpds_count(self._s))
+        n = self._count()
         flags = np.frombuffer(ffi.buffer(lib.vpds_flags(self._s), n), dtype=np.uint8) if n else np.empty(0, np.uint8)
         return (flags & 1).astype(bool)
 
     @property
     def stats(self) -> dict:
-        st = lib.vpds_get_stats(self._s)
+        st = lib.vpds_get_stats(self._sampler("stats"))
         return {k: getattr(st, k) for k in ("darts", "accepted", "levels", "peak_active_cells",
                                              "bytes_held", "peak_bytes", "sizing_calls", "delta",
                                              "t", "maximal", "domain_calls")}
@@ -436,5 +648,5 @@ class PoissonDisk:
 
     @property
     def seed(self) -> int:
-        """The C seed in use (an int rng is used as is)."""
+        """The C seed in use (an int rng below 2**64 is used as is)."""
         return self._seed
