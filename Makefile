@@ -119,8 +119,10 @@ $(VENV)/.vpds-installed: $(PKG_SRC) | $(PY)
 	$(PIP) "./bindings/python[demo]"
 	@touch $@
 
+# pytest-xdist: one worker per core (PYTEST_WORKERS=0 for one process)
+PYTEST_WORKERS ?= auto
 check-py: $(SAMPLE_TOOL) $(VENV)/.vpds-installed
-	$(PY) -m pytest -q tests/py
+	$(PY) -m pytest -q -n $(PYTEST_WORKERS) tests/py
 
 # The C tests again with AddressSanitizer and UndefinedBehaviorSanitizer (a separate build).
 check-sanitizers:
