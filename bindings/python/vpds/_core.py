@@ -252,6 +252,7 @@ class PoissonDisk:
         """Back to the empty sampling (the fixed points kept), with the same seed."""
         self._s = self._new_sampler(self._desc)
         self.num_generated = int(lib.vpds_count(self._s))
+        self._refining: Optional[tuple[float, int]] = None  # refine(t) stopped by an error
         return self
 
     def _new_sampler(self, desc: Any) -> Any:
@@ -327,16 +328,23 @@ class PoissonDisk:
 
     def refine(self, t: float) -> np.ndarray:
         """Discrete decrease (Section 4.3): maximal at the smaller scale t; returns the new
-        samples."""
+        samples. After an exception (Ctrl-C, a raising callable), refine(t) again continues
+        the refinement and returns all its samples, those of the stopped call included."""
+        t = float(t)
         before = int(lib.vpds_count(self._s))
+        st = lib.vpds_get_stats(self._s)
+        if self._refining is not None and self._refining[0] == t and st.t == t and not st.maximal:
+            before = self._refining[1]
+        self._refining = (t, before)
         first = [True]
 
         def step() -> int:
             if first[0]:
                 first[0] = False
-                return lib.vpds_refine(self._s, float(t))
+                return lib.vpds_refine(self._s, t)
             return lib.vpds_run(self._s)
         self._run_until(step, None, f"refining to t={t}")
+        self._refining = None
         self.num_generated = int(lib.vpds_count(self._s))
         return self.points[before:]
 
