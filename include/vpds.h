@@ -91,10 +91,14 @@ typedef struct vpds_allocator {
 
 /* r(x) > 0 at a point x of dim coordinates. */
 typedef double (*vpds_sizing_fn)(const double *x, void *user);
-/* r at n points (x holds n*dim doubles); write n radii to r_out; return 0, or non-zero to fail. */
+/* r at n points (x holds n*dim doubles); write n radii to r_out; return 0, or non-zero to fail.
+ * A failure stops the call at once with VPDS_ERR_SIZING (r_out is not read), leaving the sampler
+ * as a pause would: calling again gives the points of a run that never failed. A binding whose
+ * callback raised (Ctrl-C in Python) returns non-zero and reports its exception after the call. */
 typedef int (*vpds_sizing_batch_fn)(const double *x, size_t n, double *r_out, void *user);
 /* Signed distance to the domain's boundary, negative inside (a point with 0 is inside too),
- * 1-Lipschitz; +INFINITY is allowed far outside. The domain is box ∩ {x : domain(x) <= 0}. */
+ * 1-Lipschitz; +INFINITY is allowed far outside. The domain is box ∩ {x : domain(x) <= 0}.
+ * NaN is a failure: the call stops with VPDS_ERR_DOMAIN, as a sizing_batch failure does. */
 typedef double (*vpds_domain_fn)(const double *x, void *user);
 
 /* Passed to the progress callback between chunks of work. */

@@ -423,36 +423,43 @@ vpds_status vpdsi_stream_next(vpds_sampler *s, double t_min, double *x_out, doub
         return VPDS_OK;
     }
     if (!st->active && (e = build_regions(s)) != VPDS_OK) return e;
+    /* The top region is read, not popped, until every callback of the step has answered: a
+     * failing sizing or domain callback then leaves the heap as it was, record for record (a
+     * pop and a push of the same record would reorder regions of equal keys, and a retry
+     * would take another of them first), and no draw is spent. The step's pop and push come
+     * after, in the order of a run that never failed. */
     for (;;) {
         double key, next, centre[VPDS_MAX_DIM], half[VPDS_MAX_DIM], bound, y[VPDS_MAX_DIM], gy;
-        double h = 0;
-        int resolved;
+        double h = 0, t = 0, x[VPDS_MAX_DIM], rx = 0;
+        int resolved, event;
         unsigned level;
         uint64_t *c = rec + REC_COORD;
+        size_t w = rec_words(s);
         key = rec_key(st->heap);
         if (key <= t_min) return VPDS_STREAM_END; /* every region is below: nothing consumed */
         if (heap_reserve(s, (size_t)1 << d)) {
             vpdsi_set_error(s, "out of memory for the stream's regions");
             return VPDS_ERR_OUT_OF_MEMORY;
         }
-        heap_pop(s, rec);
+        memcpy(rec, st->heap, w * sizeof(uint64_t));
         level = (unsigned)rec[1];
         memcpy(&gy, rec + 2, sizeof gy);
         memcpy(y, rec + REC_COORD + d, (size_t)d * sizeof(double));
-        next = st->count ? rec_key(st->heap) : 0.0;
+        /* the largest key below the top's: one of its children's (the key the top would
+         * have after a pop) */
+        next = st->count > 1 ? rec_key(st->heap + w) : 0.0;
+        if (st->count > 2 && rec_key(st->heap + 2 * w) > next) next = rec_key(st->heap + 2 * w);
         region_box(s, level, c, centre, half);
         for (k = 0; k < d; k++) h += half[k] * half[k];
         h = sqrt(h);
         if (isfinite(key) && level < st->max_level) {
             /* too coarse for the scale of its key: hand its key to its 2^d children */
             double r;
-            if ((e = vpdsi_radius_at(s, centre, &r)) != VPDS_OK) {
-                heap_push(s, key, level, c, gy, y);
-                return e;
-            }
+            if ((e = vpdsi_radius_at(s, centre, &r)) != VPDS_OK) return e;
             if (h > STREAM_SPLIT * key * s->coverage * (r - s->sizing.lipschitz * h) ||
                 r <= s->sizing.lipschitz * h) {
                 uint64_t b, cc[VPDS_MAX_DIM];
+                heap_pop(s, rec);
                 for (b = 0; b < ((uint64_t)1 << d); b++) {
                     int skip = 0;
                     for (k = 0; k < d; k++) {
@@ -469,45 +476,38 @@ vpds_status vpdsi_stream_next(vpds_sampler *s, double t_min, double *x_out, doub
             /* the cached maximiser still holds if no sample since lowered g there: then the
              * region's bound is unchanged (samples only lower g) */
             double g1, ub1, zero[VPDS_MAX_DIM] = {0};
-            if ((e = eval_boxes(s, y, 1, zero, &g1, &ub1)) != VPDS_OK) {
-                heap_push(s, key, level, c, gy, y);
-                return e;
-            }
+            if ((e = eval_boxes(s, y, 1, zero, &g1, &ub1)) != VPDS_OK) return e;
             if (g1 == gy) {
                 resolved = 1;
                 bound = key;
             }
         }
-        if (!resolved) {
-            e = search_region(s, centre, half, &bound, y, &gy);
-            if (e != VPDS_OK) {
-                heap_push(s, key, level, c, -1.0, NULL);
-                return e;
-            }
-        }
-        heap_push(s, bound, level, c, gy, y);
-        if (bound < next) continue;
-        {
-            /* an event at t = bound (an upper bound of max g), never above the scale at which
-             * the set is already maximal (the last event's, or a run's) */
-            double t = bound, x[VPDS_MAX_DIM], rx, ry;
+        if (!resolved && (e = search_region(s, centre, half, &bound, y, &gy)) != VPDS_OK) return e;
+        /* an event at t = bound (an upper bound of max g), never above the scale at which the
+         * set is already maximal (the last event's, or a run's) */
+        event = bound >= next;
+        if (event) {
+            double ry;
+            t = bound;
             if (s->run.phase == VPDSI_DONE && t > s->run.t) t = s->run.t;
-            if (t <= t_min) return VPDS_STREAM_END;
-            if ((e = vpdsi_radius_at(s, y, &ry)) != VPDS_OK) return e;
-            memcpy(x, y, (size_t)d * sizeof(double));
-            rx = ry;
-            if (s->two_radii) {
-                e = draw_near(s, t, y, ry, x, &rx);
-                if (e != VPDS_OK) {
+            if (t > t_min) {
+                if ((e = vpdsi_radius_at(s, y, &ry)) != VPDS_OK) return e;
+                memcpy(x, y, (size_t)d * sizeof(double));
+                rx = ry;
+                if (s->two_radii && (e = draw_near(s, t, y, ry, x, &rx)) != VPDS_OK) {
                     s->rng = start;
                     return e;
                 }
             }
-            vpdsi_append_sample(s, x, rx, t, 0);
-            s->stats.accepted++;
-            memcpy(x_out, x, (size_t)d * sizeof(double));
-            *t_out = t;
-            return VPDS_OK;
         }
+        heap_pop(s, rec);
+        heap_push(s, bound, level, c, gy, y);
+        if (!event) continue;
+        if (t <= t_min) return VPDS_STREAM_END;
+        vpdsi_append_sample(s, x, rx, t, 0);
+        s->stats.accepted++;
+        memcpy(x_out, x, (size_t)d * sizeof(double));
+        *t_out = t;
+        return VPDS_OK;
     }
 }

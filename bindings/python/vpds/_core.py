@@ -8,6 +8,7 @@ from typing import Any, Callable, Iterator, NamedTuple, Optional, Sequence, Unio
 import numpy as np
 import numpy.typing as npt
 
+from ._callbacks import as_values, escaped, keep, raise_failure, take
 from ._errors import (VpdsDomainError, VpdsError, VpdsSizingError, VpdsStateError,
                       VpdsUnsupportedError, VpdsValueError, _raise, created)
 from ._optional import MissingDependencyError, require
@@ -24,19 +25,21 @@ RULES = {"prior": lib.VPDS_RULE_PRIOR, "current": lib.VPDS_RULE_CURRENT,
 _CHUNK = 50_000
 
 
-@ffi.def_extern()
+@ffi.def_extern(error=1, onerror=escaped("_callback_error"))
 def vpds_py_sizing_batch(x, n, r_out, user):  # type: ignore[no-untyped-def]
-    """Called by the C library with n points: one vectorised call of the Python sizing."""
-    owner = ffi.from_handle(user)
+    """Called by the C library with n points: one vectorised call of the Python sizing. An
+    exception is kept in the owner's _callback_error (re-raised after the C call) and fails
+    the batch; after one, every call fails at once until the binding has taken it."""
     try:
+        owner = ffi.from_handle(user)
+        if owner._callback_error is not None:
+            return 1
         pts = np.frombuffer(ffi.buffer(x, n * owner.d * 8), dtype=np.float64).reshape(n, owner.d)
-        r = np.asarray(owner._sizing_fn(pts), dtype=np.float64)
-        if r.shape != (n,):
-            raise ValueError(f"sizing returned shape {r.shape} for {n} points; expected ({n},)")
+        r = as_values(owner._sizing_fn(pts), n, "sizing")
         np.frombuffer(ffi.buffer(r_out, n * 8), dtype=np.float64)[:] = r
         return 0
     except BaseException as exc:  # noqa: BLE001 - re-raised in Python after the C call returns
-        owner._callback_error = exc
+        keep(user, "_callback_error", exc)
         return 1
 
 
@@ -380,6 +383,7 @@ class PoissonDisk:
         self.num_generated = 0 if self._s is None else int(lib.vpds_count(self._s))
         if self.optimization is not None:
             self._optimizer_rng = np.random.default_rng(self._seed)
+        self._refining: Optional[tuple[float, int]] = None  # refine(t) stopped by an error
         return self
 
     def _sampler(self, what: str) -> Any:
@@ -424,16 +428,17 @@ class PoissonDisk:
         return s
 
     def _check(self, st: int, sampler: Any = None) -> int:
-        """Raise a C error status with the message of `sampler` (default: this one's) and the
-        exception a Python callback raised, if any."""
-        if st < 0:
-            cause, self._callback_error = self._callback_error, None
-            if cause is None and self._domain is not None:
-                cause, self._domain.error = self._domain.error, None
-            if isinstance(cause, KeyboardInterrupt):
-                raise cause
-            _raise(st, ffi.string(lib.vpds_last_error(self._s if sampler is None else sampler)).decode(),
-                   cause)
+        """Raise a C error status with the message of `sampler` (default: this one's); an
+        exception a Python callable raised during the call is raised as itself (the C status
+        and message as a note), whatever the status."""
+        cause, where = take(self, "_callback_error"), "sizing"
+        if cause is None:
+            cause, where = take(self._domain, "error"), "domain"
+        if st < 0 or cause is not None:
+            message = ffi.string(lib.vpds_last_error(self._s if sampler is None else sampler)).decode()
+            if cause is None:
+                _raise(st, message)
+            raise_failure(st, message, cause, where)
         return st
 
     # -- sampling -----------------------------------------------------------------------------
@@ -527,16 +532,23 @@ class PoissonDisk:
 
     def refine(self, t: float) -> np.ndarray:
         """Discrete decrease (Section 4.3): maximal at the smaller scale t; returns the new
-        samples."""
+        samples. After an exception (Ctrl-C, a raising callable), refine(t) again continues
+        the refinement and returns all its samples, those of the stopped call included."""
+        t = float(t)
         before = int(lib.vpds_count(self._sampler("refine()")))
+        st = lib.vpds_get_stats(self._s)
+        if self._refining is not None and self._refining[0] == t and st.t == t and not st.maximal:
+            before = self._refining[1]
+        self._refining = (t, before)
         first = [True]
 
         def step() -> int:
             if first[0]:
                 first[0] = False
-                return lib.vpds_refine(self._s, float(t))
+                return lib.vpds_refine(self._s, t)
             return lib.vpds_run(self._s)
         self._run_until(step, None, f"refining to t={t}")
+        self._refining = None
         self.num_generated = int(lib.vpds_count(self._s))
         return self.points[before:]
 

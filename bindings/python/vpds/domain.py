@@ -19,6 +19,7 @@ from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
+from ._callbacks import as_values, escaped, keep
 from ._errors import created
 from ._vpds import ffi, lib
 
@@ -46,18 +47,20 @@ def estimate_radius(n: int, d: int, volume: float = 1.0) -> float:
     return 2.0 * (JAMMING_DENSITY[d] * volume / (n * unit_ball)) ** (1.0 / d)
 
 
-@ffi.def_extern(error=float("nan"))
+@ffi.def_extern(error=float("nan"), onerror=escaped("error"))
 def vpds_py_domain(x, user):  # type: ignore[no-untyped-def]
-    """Called by the C library at one point: the Python sdf on a (1, d) array."""
-    owner = ffi.from_handle(user)
+    """Called by the C library at one point: the Python sdf on a (1, d) array. An exception is
+    kept in the Domain's `error` and signalled by NaN (the library stops with VPDS_ERR_DOMAIN;
+    the binding raises the exception itself); after one, every call returns NaN at once until
+    the binding has taken it."""
     try:
+        owner = ffi.from_handle(user)
+        if owner.error is not None:
+            return float("nan")
         p = np.frombuffer(ffi.buffer(x, owner.d * 8), dtype=np.float64).reshape(1, owner.d)
-        v = np.asarray(owner.fn(p.copy()), dtype=np.float64).reshape(-1)
-        if v.shape != (1,):
-            raise ValueError(f"domain returned shape {v.shape} for 1 point; expected (1,)")
-        return float(v[0])
+        return float(as_values(owner.fn(p.copy()), 1, "domain", flat=True)[0])
     except BaseException as exc:  # noqa: BLE001 - re-raised in Python after the C call returns
-        owner.error = exc
+        keep(user, "error", exc)
         return float("nan")
 
 

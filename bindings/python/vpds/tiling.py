@@ -14,6 +14,7 @@ from typing import Any, Callable, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
+from ._callbacks import raise_failure, take
 from ._core import RULES, SizingGrid, _seed_from
 from ._errors import _raise, created
 from ._vpds import ffi, lib
@@ -130,7 +131,8 @@ class TilingSpec:
 
 
 class _CallbackOwner:
-    """What vpds_py_sizing_batch needs: d, the callable, and a slot for its exception."""
+    """What vpds_py_sizing_batch needs: d, the callable, and a slot for its exception (see
+    vpds._callbacks)."""
 
     def __init__(self, d: int, fn: Callable[[np.ndarray], np.ndarray]):
         self.d = d
@@ -298,11 +300,12 @@ class Tiling:
         lib.vpds_set_budget(s, budget)
         while True:
             st = lib.vpds_run(s)
-            if st < 0:
-                cause = None
-                if self._owner is not None:
-                    cause, self._owner._callback_error = self._owner._callback_error, None
-                _raise(st, ffi.string(lib.vpds_last_error(s)).decode(), cause)
+            cause = take(self._owner, "_callback_error")
+            if st < 0 or cause is not None:  # a callable's exception is raised as itself
+                message = ffi.string(lib.vpds_last_error(s)).decode()
+                if cause is None:
+                    _raise(st, message)
+                raise_failure(st, message, cause, "sizing")
             if st == lib.VPDS_OK:
                 break
         n, f = int(lib.vpds_count(s)), int(nfix[0])
