@@ -25,7 +25,7 @@ SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-
 
 # Fuzzing: the harnesses FUZZERS, from FUZZ_DIR/fuzz_<name>.c with seeds in FUZZ_DIR/corpus/<name>,
 # built and run in FUZZ_OUT (logs, grown corpora, and libFuzzer's crash-, leak-, timeout- and oom-
-# inputs in FUZZ_OUT/artifacts).
+# inputs in FUZZ_OUT/artifacts). tests/fuzz_fails.sh points these at harnesses that must fail.
 FUZZERS ?= run grid sequence sizing domain
 FUZZ_DIR ?= fuzz
 FUZZ_OUT ?= $(BUILD)/fuzz
@@ -43,7 +43,7 @@ FUZZ_LIB_OBJ := $(LIB_SRC:libvpds/%.c=$(BUILD)/fuzz/obj/%.o)
 VALGRIND := valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect
 
 .PHONY: all test demo deps install clean bench check-c check-flann check-py check-sanitizers check-abi \
-	check-valgrind check-determinism check-fuzz fuzz
+	check-valgrind check-determinism check-fuzz check-fuzz-fails fuzz
 all: $(SHARED) $(STATIC) $(BUILD)/vpds.pc
 
 $(BUILD)/obj/%.o: libvpds/%.c $(LIB_HDR)
@@ -107,11 +107,14 @@ fuzz: $(FUZZERS:%=$(FUZZ_OUT)/fuzz_%)
 	  $(FUZZ_CORPUS) $(FUZZERS)
 
 # The corpus replayed without instrumentation, then each harness fuzzed for FUZZ_TEST_SECONDS
-# from its seeds.
-check-fuzz: $(FUZZERS:%=$(BUILD)/fuzz/replay_%)
+# from its seeds; first, that a harness which crashes, leaks or hangs fails `make fuzz`.
+check-fuzz: $(FUZZERS:%=$(BUILD)/fuzz/replay_%) check-fuzz-fails
 	@set -e; for f in $(FUZZERS); do printf '%-24s' "replay corpus/$$f:"; \
 	  $(BUILD)/fuzz/replay_$$f fuzz/corpus/$$f; done
 	@$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(FUZZ_TEST_SECONDS) FUZZ_CORPUS=fresh
+
+check-fuzz-fails: $(FUZZ_LIB_OBJ)
+	@bash tests/fuzz_fails.sh $(BUILD)
 
 check-valgrind: $(TEST_BIN)
 	@set -e; for t in $(TEST_BIN); do echo "== valgrind $$t"; VPDS_TEST_QUICK=1 $(VALGRIND) $$t; done
