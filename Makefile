@@ -23,10 +23,23 @@ FLANN_TEST := $(BUILD)/tests/flann_kdtree
 SAMPLE_TOOL := $(BUILD)/tests/sample_tool
 SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 
-FUZZERS := run grid sequence sizing domain
+# Fuzzing: the harnesses FUZZERS, from FUZZ_DIR/fuzz_<name>.c with seeds in FUZZ_DIR/corpus/<name>,
+# built and run in FUZZ_OUT (logs, grown corpora, and libFuzzer's crash-, leak-, timeout- and oom-
+# inputs in FUZZ_OUT/artifacts). tests/fuzz_fails.sh points these at harnesses that must fail.
+FUZZERS ?= run grid sequence sizing domain
+FUZZ_DIR ?= fuzz
+FUZZ_OUT ?= $(BUILD)/fuzz
 FUZZ_SECONDS ?= 120
 FUZZ_TEST_SECONDS ?= 30
-FUZZ_FLAGS := -g -O1 -std=c99 -Iinclude -ffp-contract=off -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all
+# seconds one input may take before it counts as a hang; the memory limit of a harness (and of
+# one allocation); grow: keep the inputs found for the next run, fresh: start from the seeds
+FUZZ_TIMEOUT ?= 10
+FUZZ_RSS_MB ?= 2048
+FUZZ_CORPUS ?= grow
+FUZZ_CFLAGS := -g -O1 -std=c99 -Iinclude -ffp-contract=off -fsanitize=address,undefined \
+  -fno-sanitize-recover=all
+FUZZ_FLAGS := $(FUZZ_CFLAGS) -fsanitize=fuzzer
+FUZZ_LIB_OBJ := $(LIB_SRC:libvpds/%.c=$(BUILD)/fuzz/obj/%.o)
 # The project's Python environment: make demo creates it and installs the package with the demo's
 # extras; make test adds tests/requirements.txt. Nothing goes into the system's Python.
 VENV    ?= $(BUILD)/venv
@@ -38,7 +51,7 @@ PKG_SRC := bindings/python/pyproject.toml bindings/python/setup.py $(wildcard bi
 VALGRIND := valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect
 
 .PHONY: all test demo deps install clean bench check-c check-flann check-py check-sanitizers check-abi \
-	check-valgrind check-determinism check-fuzz fuzz
+	check-valgrind check-determinism check-fuzz check-fuzz-fails fuzz
 all: $(SHARED) $(STATIC) $(BUILD)/vpds.pc
 
 $(BUILD)/obj/%.o: libvpds/%.c $(LIB_HDR)
@@ -81,25 +94,35 @@ check-c: $(TEST_BIN)
 check-flann: $(FLANN_TEST)
 	$(FLANN_TEST)
 
-# libFuzzer harnesses (clang) and the same harnesses as plain programs that replay the corpus (gcc)
-$(BUILD)/fuzz/fuzz_%: fuzz/fuzz_%.c fuzz/fuzz_common.h $(LIB_SRC) $(LIB_HDR)
+# libFuzzer harnesses (clang; the library instrumented once for all of them) and the same
+# harnesses as plain programs that replay the corpus (gcc)
+$(BUILD)/fuzz/obj/%.o: libvpds/%.c $(LIB_HDR)
 	@mkdir -p $(dir $@)
-	clang $(FUZZ_FLAGS) $< $(LIB_SRC) -lm -o $@
+	clang $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link -c $< -o $@
+
+$(FUZZ_OUT)/fuzz_%: $(FUZZ_DIR)/fuzz_%.c fuzz/fuzz_common.h $(FUZZ_LIB_OBJ)
+	@mkdir -p $(dir $@)
+	clang $(FUZZ_FLAGS) $< $(FUZZ_LIB_OBJ) -lm -o $@
 
 $(BUILD)/fuzz/replay_%: fuzz/fuzz_%.c fuzz/replay.c fuzz/fuzz_common.h $(STATIC)
 	@mkdir -p $(dir $@)
 	$(CC) -std=c99 -O2 -g -Iinclude -ffp-contract=off fuzz/replay.c $< -o $@ $(STATIC) -lm
 
-# make fuzz: each harness for FUZZ_SECONDS, growing build/fuzz/corpus_<name> from fuzz/corpus/<name>
-fuzz: $(FUZZERS:%=$(BUILD)/fuzz/fuzz_%)
-	@set -e; for f in $(FUZZERS); do mkdir -p $(BUILD)/fuzz/corpus_$$f; \
-	  echo "== fuzz_$$f for $(FUZZ_SECONDS) s"; \
-	  ASAN_OPTIONS=allocator_may_return_null=1 $(BUILD)/fuzz/fuzz_$$f -max_total_time=$(FUZZ_SECONDS) -max_len=512 -print_final_stats=1 \
-	    $(BUILD)/fuzz/corpus_$$f fuzz/corpus/$$f 2>&1 | grep -E "stat::number_of_executed_units|stat::average_exec_per_sec|ERROR|invariant" ; done
+# make fuzz: each harness for FUZZ_SECONDS (one line each; a finding fails the target and is
+# shown), growing FUZZ_OUT/corpus_<name> from the seeds
+fuzz: $(FUZZERS:%=$(FUZZ_OUT)/fuzz_%)
+	@bash fuzz/run.sh $(FUZZ_OUT) $(FUZZ_SECONDS) $(FUZZ_TIMEOUT) $(FUZZ_RSS_MB) $(FUZZ_DIR)/corpus \
+	  $(FUZZ_CORPUS) $(FUZZERS)
 
-check-fuzz: $(FUZZERS:%=$(BUILD)/fuzz/replay_%)
-	@set -e; for f in $(FUZZERS); do echo "== replay fuzz/corpus/$$f (gcc)"; $(BUILD)/fuzz/replay_$$f fuzz/corpus/$$f; done
-	$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(FUZZ_TEST_SECONDS)
+# The corpus replayed without instrumentation, then each harness fuzzed for FUZZ_TEST_SECONDS
+# from its seeds; first, that a harness which crashes, leaks or hangs fails `make fuzz`.
+check-fuzz: $(FUZZERS:%=$(BUILD)/fuzz/replay_%) check-fuzz-fails
+	@set -e; for f in $(FUZZERS); do printf '%-24s' "replay corpus/$$f:"; \
+	  $(BUILD)/fuzz/replay_$$f fuzz/corpus/$$f; done
+	@$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(FUZZ_TEST_SECONDS) FUZZ_CORPUS=fresh
+
+check-fuzz-fails: $(FUZZ_LIB_OBJ)
+	@bash tests/fuzz_fails.sh $(BUILD)
 
 check-valgrind: $(TEST_BIN)
 	@set -e; for t in $(TEST_BIN); do echo "== valgrind $$t"; VPDS_TEST_QUICK=1 $(VALGRIND) $$t; done

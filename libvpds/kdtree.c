@@ -160,6 +160,28 @@ double vpdsi_box_maxdist2(const vpdsi_kdtree *t, const double *p, const double *
 
 #define dist2(a, b, dim) vpdsi_torus_dist2((a), (b), (dim), t->period)
 
+/* The per-sample tests, shared by the tree walks and the list versions so that both give the
+ * same bits. */
+static double conflict_reach(const vpdsi_kd_samples *s, int32_t i, double ry, int rule,
+                             double scale)
+{
+    return scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], ry);
+}
+
+static double ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i, const double *y,
+                    double slack, double ry, int rule)
+{
+    double fi = vpdsi_rule_f((vpds_rule)rule, s->r[i], ry);
+    return (sqrt(dist2(y, s->x + (size_t)i * (size_t)t->dim, t->dim)) + slack) / fi;
+}
+
+static int covers_box(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i, const double *lo,
+                      const double *hi, double r_lo, int rule, double scale)
+{
+    double f = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_lo);
+    return f > 0 && vpdsi_box_maxdist2(t, s->x + (size_t)i * (size_t)t->dim, lo, hi) <= f * f;
+}
+
 int32_t vpdsi_kd_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *y,
                           double ry, int rule, double scale, double lipschitz, int32_t *witness)
 {
@@ -175,8 +197,8 @@ int32_t vpdsi_kd_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, cons
         if (nd->left < 0) {
             int32_t i;
             for (i = nd->head; i >= 0; i = t->next[i]) {
-                double d2 = dist2(y, s->x + (size_t)i * d, d);
-                double f = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], ry);
+                double d2, f = conflict_reach(s, i, ry, rule, scale);
+                d2 = dist2(y, s->x + (size_t)i * d, d);
                 if (lipschitz >= 0 && !(s->flags[i] & VPDSI_SAMPLE_OWN_RADIUS)) {
                     double gap = fabs(ry - s->r[i]);
                     double allowed = lipschitz * sqrt(d2) * (1 + 1e-9) + 1e-12 * (ry + s->r[i]);
@@ -212,14 +234,11 @@ static double far_bound(double a, double b, double c0, double c1, double w, doub
     return w + (g0 < g1 ? g0 : g1);
 }
 
-int vpdsi_kd_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *lo,
-                    const double *hi, double r_hi, int rule, double scale, int split,
-                    vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap)
+/* Centres (c0, c1) and half-width w of the sub-intervals gather measures against, per axis. */
+static void gather_centres(int d, const double *lo, const double *hi, int split, double *c0,
+                           double *c1, double *w)
 {
-    int32_t stack[STACK_MAX];
-    int top = 0, d = t->dim, k;
-    double c0[VPDS_MAX_DIM], c1[VPDS_MAX_DIM], w[VPDS_MAX_DIM];
-    if (t->n_nodes == 0) return 0;
+    int k;
     for (k = 0; k < d; k++) {
         double mid = 0.5 * (lo[k] + hi[k]);
         if (split) {
@@ -231,6 +250,31 @@ int vpdsi_kd_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const doub
             w[k] = 0.5 * (hi[k] - lo[k]);
         }
     }
+}
+
+/* Gather's test of one sample: it may cover a whole sub-box at reach scale * f(r(x), r_hi). */
+static int may_cover(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i, const double *c0,
+                     const double *c1, const double *w, double r_hi, int rule, double scale)
+{
+    const double *x = s->x + (size_t)i * (size_t)t->dim;
+    double f = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_hi), need = 0;
+    int k;
+    for (k = 0; k < t->dim; k++) {
+        double fb = far_bound(x[k], x[k], c0[k], c1[k], w[k], t->period[k]);
+        need += fb * fb;
+    }
+    return !(need > f * f);
+}
+
+int vpdsi_kd_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *lo,
+                    const double *hi, double r_hi, int rule, double scale, int split,
+                    vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap)
+{
+    int32_t stack[STACK_MAX];
+    int top = 0, d = t->dim, k;
+    double c0[VPDS_MAX_DIM], c1[VPDS_MAX_DIM], w[VPDS_MAX_DIM];
+    if (t->n_nodes == 0) return 0;
+    gather_centres(d, lo, hi, split, c0, c1, w);
     stack[top++] = 0;
     while (top > 0) {
         int32_t n = stack[--top];
@@ -244,17 +288,10 @@ int vpdsi_kd_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const doub
         if (need > reach * reach) continue;
         if (nd->left < 0) {
             int32_t i;
-            for (i = nd->head; i >= 0; i = t->next[i]) {
-                const double *x = s->x + (size_t)i * d;
-                double f = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_hi);
-                need = 0;
-                for (k = 0; k < d; k++) {
-                    double fb = far_bound(x[k], x[k], c0[k], c1[k], w[k], t->period[k]);
-                    need += fb * fb;
-                }
-                if (need > f * f) continue;
-                if (push_index(m, out, count, cap, i)) return -1;
-            }
+            for (i = nd->head; i >= 0; i = t->next[i])
+                if (may_cover(t, s, i, c0, c1, w, r_hi, rule, scale) &&
+                    push_index(m, out, count, cap, i))
+                    return -1;
         } else {
             stack[top++] = nd->left;
             stack[top++] = nd->right;
@@ -294,12 +331,8 @@ int vpdsi_kd_box_covered(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const
                          double scale)
 {
     size_t j;
-    for (j = 0; j < n; j++) {
-        int32_t i = cand[j];
-        double f = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_lo);
-        if (f > 0 && vpdsi_box_maxdist2(t, s->x + (size_t)i * (size_t)t->dim, lo, hi) <= f * f)
-            return 1;
-    }
+    for (j = 0; j < n; j++)
+        if (covers_box(t, s, cand[j], lo, hi, r_lo, rule, scale)) return 1;
     return 0;
 }
 
@@ -307,7 +340,7 @@ double vpdsi_kd_min_ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, cons
                           double slack, double ry, int rule, int32_t *arg)
 {
     int32_t stack[STACK_MAX];
-    int top = 0, d = t->dim;
+    int top = 0;
     double best = INFINITY;
     *arg = -1;
     if (t->n_nodes == 0) return best;
@@ -321,8 +354,7 @@ double vpdsi_kd_min_ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, cons
         if (nd->left < 0) {
             int32_t i;
             for (i = nd->head; i >= 0; i = t->next[i]) {
-                double fi = vpdsi_rule_f((vpds_rule)rule, s->r[i], ry);
-                double q = (sqrt(dist2(y, s->x + (size_t)i * d, d)) + slack) / fi;
+                double q = ratio(t, s, i, y, slack, ry, rule);
                 if (q < best) {
                     best = q;
                     *arg = i;
@@ -333,6 +365,117 @@ double vpdsi_kd_min_ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, cons
             stack[top++] = near ? nd->right : nd->left;
             stack[top++] = near ? nd->left : nd->right;
         }
+    }
+    return best;
+}
+
+/* ---- Candidate lists: the same tests over a list of sample indices instead of the tree ---- */
+
+/* Gap between the intervals [a, b] and [lo, hi] along an axis of period P (0: open). */
+static double interval_gap(double a, double b, double lo, double hi, double P)
+{
+    double best = lo > b ? lo - b : a > hi ? a - hi : 0, g;
+    if (P > 0 && best > 0) {
+        g = lo + P > b ? lo + P - b : a > hi + P ? a - (hi + P) : 0;
+        if (g < best) best = g;
+        g = lo - P > b ? lo - P - b : a > hi - P ? a - (hi - P) : 0;
+        if (g < best) best = g;
+    }
+    return best;
+}
+
+/* How far from the box a sample of radius r may lie and still matter (see kdtree.h). */
+static double near_limit(double r, double r_bound, double scale, double slack)
+{
+    return scale * (r > r_bound ? r : r_bound) * (1 + 1e-9) + slack;
+}
+
+static int is_near(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i, const double *lo,
+                   const double *hi, double r_bound, double scale, double slack)
+{
+    double lim = near_limit(s->r[i], r_bound, scale, slack);
+    return vpdsi_box_mindist2(t, s->x + (size_t)i * (size_t)t->dim, lo, hi) <= lim * lim;
+}
+
+int vpdsi_kd_near_box(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *lo,
+                      const double *hi, double r_bound, double scale, double slack, size_t limit,
+                      vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap)
+{
+    int32_t stack[STACK_MAX];
+    int top = 0, d = t->dim, k;
+    size_t end = *count + limit;
+    if (t->n_nodes == 0) return 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        int32_t n = stack[--top];
+        const vpdsi_kd_node *nd = &t->nodes[n];
+        const double *blo = BOX_LO(t, n), *bhi = BOX_HI(t, n);
+        double lim = near_limit(nd->rmax, r_bound, scale, slack), gap2 = 0;
+        for (k = 0; k < d; k++) {
+            double g = interval_gap(blo[k], bhi[k], lo[k], hi[k], t->period[k]);
+            gap2 += g * g;
+        }
+        if (gap2 > lim * lim) continue;
+        if (nd->left < 0) {
+            int32_t i;
+            for (i = nd->head; i >= 0; i = t->next[i]) {
+                if (!is_near(t, s, i, lo, hi, r_bound, scale, slack)) continue;
+                if (*count == end) return 1;
+                if (push_index(m, out, count, cap, i)) return -1;
+            }
+        } else {
+            stack[top++] = nd->left;
+            stack[top++] = nd->right;
+        }
+    }
+    return 0;
+}
+
+size_t vpdsi_kd_filter_near(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *from,
+                            size_t n, const double *lo, const double *hi, double r_bound,
+                            double scale, double slack, int32_t *out)
+{
+    size_t j, count = 0;
+    for (j = 0; j < n; j++)
+        if (is_near(t, s, from[j], lo, hi, r_bound, scale, slack)) out[count++] = from[j];
+    return count;
+}
+
+int vpdsi_kd_list_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *cand,
+                           size_t n, const double *y, double ry, int rule, double scale)
+{
+    size_t j;
+    for (j = 0; j < n; j++) {
+        int32_t i = cand[j];
+        double f = conflict_reach(s, i, ry, rule, scale);
+        if (dist2(y, s->x + (size_t)i * (size_t)t->dim, t->dim) < f * f) return 1;
+    }
+    return 0;
+}
+
+int vpdsi_kd_list_box_covered(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
+                              const int32_t *cand, size_t n, const double *lo, const double *hi,
+                              double r_hi, double r_lo, int rule, double scale)
+{
+    double c0[VPDS_MAX_DIM], c1[VPDS_MAX_DIM], w[VPDS_MAX_DIM];
+    size_t j;
+    gather_centres(t->dim, lo, hi, 0, c0, c1, w);
+    for (j = 0; j < n; j++)
+        if (may_cover(t, s, cand[j], c0, c1, w, r_hi, rule, scale) &&
+            covers_box(t, s, cand[j], lo, hi, r_lo, rule, scale))
+            return 1;
+    return 0;
+}
+
+double vpdsi_kd_list_min_ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
+                               const int32_t *cand, size_t n, const double *y, double slack,
+                               double ry, int rule)
+{
+    double best = INFINITY;
+    size_t j;
+    for (j = 0; j < n; j++) {
+        double q = ratio(t, s, cand[j], y, slack, ry, rule);
+        if (q < best) best = q;
     }
     return best;
 }

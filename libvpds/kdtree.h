@@ -84,6 +84,34 @@ int vpdsi_kd_box_covered(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const
 double vpdsi_kd_min_ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *y,
                           double slack, double ry, int rule, int32_t *arg);
 
+/* Candidate lists (uncovered.c): the samples that may matter anywhere inside a box, then the
+ * tests above read from such a list instead of the tree, with the same per-sample arithmetic,
+ * so they answer with the same bits whenever the list holds every sample they would accept.
+ *
+ * Near: |x - box| <= scale * max(r(x), r_bound) * (1 + 1e-9) + slack. Every rule's f is at most
+ * max(r(x), r(u)), so for r(u) <= r_bound over the box this holds every sample that conflicts
+ * with a point of the box or may cover a part of it; the margins absorb round-off between the
+ * tests' formulas. vpdsi_kd_near_box appends them from the tree, at most `limit` (1: more were
+ * found, the list is incomplete; -1 on OOM); vpdsi_kd_filter_near keeps those of a list (from
+ * the box of an ancestor, with an r_bound no smaller) that are near a sub-box, in order. */
+int vpdsi_kd_near_box(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *lo,
+                      const double *hi, double r_bound, double scale, double slack, size_t limit,
+                      vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap);
+size_t vpdsi_kd_filter_near(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *from,
+                            size_t n, const double *lo, const double *hi, double r_bound,
+                            double scale, double slack, int32_t *out);
+/* Whether a candidate conflicts with y (vpdsi_kd_conflict without the Lipschitz check). */
+int vpdsi_kd_list_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *cand,
+                           size_t n, const double *y, double ry, int rule, double scale);
+/* vpdsi_kd_gather (no split) at r_hi followed by vpdsi_kd_box_covered at r_lo, on candidates. */
+int vpdsi_kd_list_box_covered(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
+                              const int32_t *cand, size_t n, const double *lo, const double *hi,
+                              double r_hi, double r_lo, int rule, double scale);
+/* vpdsi_kd_min_ratio over candidates (+INFINITY: none). */
+double vpdsi_kd_list_min_ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
+                               const int32_t *cand, size_t n, const double *y, double slack,
+                               double ry, int rule);
+
 /* All samples with |x - p| <= radius, appended to *out; -1 on OOM. */
 int vpdsi_kd_radius(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *p,
                     double radius, vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap);

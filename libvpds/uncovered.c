@@ -1,8 +1,8 @@
 /* Branch-and-bound over boxes of the region's bounding box: a box is dropped when it misses
  * the region, lies outside the domain or inside one sample's coverage disk; a box point inside
  * the region and the domain and outside every coverage disk is an uncovered witness; anything
- * else splits into 2^d. Boxes
- * live in coordinates around the anchor; on a periodic axis the kd-tree wraps them. */
+ * else splits into 2^d. Boxes live in coordinates around the anchor; on a periodic axis the
+ * kd-tree wraps them. The search reads candidate lists handed down from box to sub-box. */
 #include "uncovered.h"
 #include "rules.h"
 #include "sampler.h"
@@ -12,7 +12,30 @@
 
 #define UNCOVERED_BUDGET 20000 /* boxes per question before answering "yes" conservatively */
 #define UNCOVERED_DEPTH 40
+#define LIST_CAP 128 /* candidates a box keeps for its sub-boxes; more and they read the kd-trees */
+#define LIST_SLOTS ((size_t)(UNCOVERED_DEPTH + 1) * 2 * LIST_CAP)
 
+/* Every box of a search used to walk the kd-trees from their roots, several times; a search
+ * examines thousands of boxes, most of them deep and small. Instead each box keeps two lists
+ * for its sub-boxes, filtered from its parent's: the uncovered-cell centres near it and the
+ * samples that may matter inside it (kdtree.h, "Near"). Depth first, the parent of a box at
+ * depth k is the last box examined at depth k - 1, so one slot per depth (in s->cand2) holds
+ * them. The tests read the lists with the kd-tree's own per-sample arithmetic: same answers. */
+typedef struct {
+    int u_ok, s_ok;  /* the list is complete (else the box's tests read the kd-tree) */
+    size_t u_n, s_n;
+    double r_bound;  /* the sample list holds for r(u) <= r_bound */
+} bb_lists;
+
+typedef struct {
+    vpds_sampler *s;
+    const double *alo, *ahi;
+    double centre[VPDS_MAX_DIM];
+    double r_anchor, scale, L, reach, slack;
+    int point, lists; /* lists: the slots are allocated */
+    vpdsi_kd_samples view, uview;
+    bb_lists lv[UNCOVERED_DEPTH + 1];
+} bb_search;
 
 double vpdsi_coverage_reach(const vpds_sampler *s, double r_hi)
 {
@@ -74,21 +97,196 @@ double vpdsi_uncovered_nearest(const vpds_sampler *s, const double *p)
     return vpdsi_kd_min_ratio(&s->utree, &v, p, 0.0, 1.0, (int)VPDS_RULE_PRIOR, &arg);
 }
 
+static size_t slot(int depth, int samples)
+{
+    return ((size_t)depth * 2 + (size_t)samples) * LIST_CAP;
+}
+
+/* Whether a cell that may hold an uncovered point lies within thr of c2: exactly
+ * vpdsi_uncovered_nearest(s, c2) <= thr, read from this box's list of centres when complete. */
+static int near_uncovered(bb_search *q, int depth, const double *c2, double thr)
+{
+    vpds_sampler *s = q->s;
+    bb_lists *me = &q->lv[depth];
+    size_t off = slot(depth, 0), count = off;
+    if (q->lists && depth > 0 && q->lv[depth - 1].u_ok) {
+        me->u_n = vpdsi_kd_filter_near(&s->utree, &q->uview, s->cand2 + slot(depth - 1, 0),
+                                       q->lv[depth - 1].u_n, c2, c2, 0.0, thr, q->slack,
+                                       s->cand2 + off);
+        me->u_ok = 1;
+    } else if (q->lists && vpdsi_kd_near_box(&s->utree, &q->uview, c2, c2, 0.0, thr, q->slack,
+                                             LIST_CAP, &s->mem, &s->cand2, &count,
+                                             &s->cap_cand2) == 0) {
+        me->u_n = count - off;
+        me->u_ok = 1;
+    }
+    if (!me->u_ok) return !(vpdsi_uncovered_nearest(s, c2) > thr);
+    return !(vpdsi_kd_list_min_ratio(&s->utree, &q->uview, s->cand2 + off, me->u_n, c2, 0.0, 1.0,
+                                     (int)VPDS_RULE_PRIOR) > thr);
+}
+
+/* This box's samples, from its parent's list while r stays below the parent's bound, else from
+ * the tree; r_bound = r_hi + L * diag bounds r_hi of every sub-box when r is L-Lipschitz, and a
+ * sub-box that finds otherwise starts again from the tree. */
+static void sample_list(bb_search *q, int depth, const double *lo, const double *hi, double rp,
+                        double r_hi, double diag)
+{
+    vpds_sampler *s = q->s;
+    bb_lists *me = &q->lv[depth], *up = depth > 0 ? &q->lv[depth - 1] : NULL;
+    size_t off = slot(depth, 1), count = off;
+    double rb = r_hi + q->L * diag;
+    if (!q->lists) return;
+    if (s->tree.n_nodes == 0) { /* no sample: the empty list is complete for any r */
+        me->s_n = 0;
+        me->s_ok = 1;
+        me->r_bound = INFINITY;
+        return;
+    }
+    if (up && up->s_ok && rp <= up->r_bound && r_hi <= up->r_bound) {
+        if (rb > up->r_bound) rb = up->r_bound;
+        me->s_n = vpdsi_kd_filter_near(&s->tree, &q->view, s->cand2 + slot(depth - 1, 1), up->s_n,
+                                       lo, hi, rb, q->scale, q->slack, s->cand2 + off);
+        me->s_ok = 1;
+    } else if (vpdsi_kd_near_box(&s->tree, &q->view, lo, hi, rb, q->scale, q->slack, LIST_CAP,
+                                 &s->mem, &s->cand2, &count, &s->cap_cand2) == 0) {
+        me->s_n = count - off;
+        me->s_ok = 1;
+    }
+    me->r_bound = rb;
+}
+
+/* Whether a sample covers p at t * coverage (vpdsi_kd_conflict, from the list when complete). */
+static int p_covered(bb_search *q, int depth, const double *p, double rp)
+{
+    vpds_sampler *s = q->s;
+    int32_t w;
+    if (q->lv[depth].s_ok)
+        return q->lv[depth].s_n > 0 &&
+               vpdsi_kd_list_conflict(&s->tree, &q->view, s->cand2 + slot(depth, 1),
+                                      q->lv[depth].s_n, p, rp, (int)s->rule, q->scale);
+    return vpdsi_kd_conflict(&s->tree, &q->view, p, rp, (int)s->rule, q->scale, -1.0, &w) != -1;
+}
+
+/* Whether one sample covers the whole box, r_lo <= r <= r_hi over it (gather, then the test). */
+static vpds_status box_covered(bb_search *q, int depth, const double *lo, const double *hi,
+                               double r_lo, double r_hi, int *covered)
+{
+    vpds_sampler *s = q->s;
+    size_t off = q->lists ? LIST_SLOTS : 0;
+    if (q->lv[depth].s_ok) {
+        *covered = r_lo > 0 && q->lv[depth].s_n > 0 &&
+                   vpdsi_kd_list_box_covered(&s->tree, &q->view, s->cand2 + slot(depth, 1),
+                                             q->lv[depth].s_n, lo, hi, r_hi, r_lo, (int)s->rule,
+                                             q->scale);
+        return VPDS_OK;
+    }
+    s->n_cand2 = off;
+    if (vpdsi_kd_gather(&s->tree, &q->view, lo, hi, r_hi, (int)s->rule, q->scale, 0, &s->mem,
+                        &s->cand2, &s->n_cand2, &s->cap_cand2)) {
+        vpdsi_set_error(s, "out of memory gathering the samples near a box");
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    *covered = r_lo > 0 && vpdsi_kd_box_covered(&s->tree, &q->view, s->cand2 + off,
+                                                s->n_cand2 - off, lo, hi, r_lo, (int)s->rule,
+                                                q->scale);
+    return VPDS_OK;
+}
+
+/* One box at `depth`: *verdict 0 when it is dropped, 1 when it answers "uncovered" (a witness,
+ * or unresolved at the precision), 2 when it splits. */
+static vpds_status examine(bb_search *q, const double *lo, const double *hi, int depth,
+                           int *verdict)
+{
+    vpds_sampler *s = q->s;
+    int d = s->dim, k, in_region, covered;
+    double p[VPDS_MAX_DIM], c2[VPDS_MAX_DIM], gap2 = 0, diag2 = 0, rp, diag, r_lo, r_hi;
+    double phi_c = -INFINITY;
+    vpds_status st;
+    *verdict = 0;
+    q->lv[depth].u_ok = q->lv[depth].s_ok = 0;
+    for (k = 0; k < d; k++) {
+        /* nearest point of the box to the anchor's centre, and the box-anchor gap */
+        double g, c = q->centre[k];
+        p[k] = c < lo[k] ? lo[k] : c > hi[k] ? hi[k] : c;
+        g = q->alo[k] > hi[k] ? q->alo[k] - hi[k] : lo[k] > q->ahi[k] ? lo[k] - q->ahi[k] : 0;
+        gap2 += g * g;
+        diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    }
+    if (gap2 > q->reach * q->reach) return VPDS_OK; /* misses the region */
+    for (k = 0; k < d; k++) c2[k] = 0.5 * (lo[k] + hi[k]);
+    /* no cell that may hold an uncovered point meets the box */
+    if (s->u_ready && !near_uncovered(q, depth, c2, 0.5 * sqrt(diag2) + s->u_half)) return VPDS_OK;
+    /* the box lies outside the domain: nothing there needs covering */
+    if (s->domain) {
+        if ((st = vpdsi_domain_at(s, c2, &phi_c)) != VPDS_OK) return st;
+        if (phi_c > 0.5 * sqrt(diag2)) return VPDS_OK;
+    }
+    if ((st = vpdsi_radius_at(s, p, &rp)) != VPDS_OK) return st;
+    if (q->point) {
+        double f = q->scale * vpdsi_rule_f(s->rule, q->r_anchor, rp), d2 = 0;
+        for (k = 0; k < d; k++) d2 += (p[k] - q->alo[k]) * (p[k] - q->alo[k]);
+        in_region = d2 <= f * f;
+    } else {
+        double d2 = 0;
+        for (k = 0; k < d; k++) {
+            const double *a = q->alo, *b = q->ahi;
+            double g = p[k] < a[k] ? a[k] - p[k] : p[k] > b[k] ? p[k] - b[k] : 0;
+            d2 += g * g;
+        }
+        in_region = d2 <= q->reach * q->reach;
+    }
+    diag = sqrt(diag2);
+    r_lo = rp - q->L * diag;
+    r_hi = rp + q->L * diag;
+    sample_list(q, depth, lo, hi, rp, r_hi, diag);
+    if (in_region && !p_covered(q, depth, p, rp)) {
+        /* p is uncovered: no sample within t*coverage*f of it; a witness if in the domain */
+        double phi = 0;
+        if (s->domain && (st = vpdsi_domain_at(s, p, &phi)) != VPDS_OK) return st;
+        if (phi <= 0) {
+            *verdict = 1;
+            return VPDS_OK;
+        }
+    }
+    if ((st = box_covered(q, depth, lo, hi, r_lo, r_hi, &covered)) != VPDS_OK) return st;
+    if (covered) return VPDS_OK;
+    /* unresolved at the precision: count it as uncovered */
+    *verdict = depth >= UNCOVERED_DEPTH || !(diag > 1e-12 * q->reach) ? 1 : 2;
+    return VPDS_OK;
+}
+
+/* Round-off allowance of the candidate lists: a few ulps of the largest coordinate a box or an
+ * image of it can reach, with room to spare. */
+static double list_slack(const vpds_sampler *s, const double *lo, const double *hi)
+{
+    double m = 0;
+    int k;
+    for (k = 0; k < s->dim; k++) {
+        double a = fabs(lo[k]) > fabs(hi[k]) ? fabs(lo[k]) : fabs(hi[k]);
+        if (a + s->period[k] > m) m = a + s->period[k];
+    }
+    return 1e-12 * m;
+}
+
 vpds_status vpdsi_uncovered_in(vpds_sampler *s, const double *alo, const double *ahi,
                                double r_anchor, int *found)
 {
     int d = s->dim, k;
     unsigned children = 1u << d, b;
-    double scale = s->run.t * s->coverage, L = s->sizing.lipschitz, sl = scale * L;
-    int point = memcmp(alo, ahi, (size_t)d * sizeof(double)) == 0;
-    /* largest reach of the region: r(u) <= r_anchor + L |u - a| and |u - a| <= scale r(u) */
-    double reach = vpdsi_coverage_reach(s, r_anchor);
-    double centre[VPDS_MAX_DIM];
     size_t top = 0, boxes = 0, stride = 2 * (size_t)d + 1, need;
-    vpdsi_kd_samples view;
+    bb_search q;
     vpds_status st;
     *found = 0;
-    if (!(sl < 1)) {
+    q.s = s;
+    q.alo = alo;
+    q.ahi = ahi;
+    q.r_anchor = r_anchor;
+    q.scale = s->run.t * s->coverage;
+    q.L = s->sizing.lipschitz;
+    q.point = memcmp(alo, ahi, (size_t)d * sizeof(double)) == 0;
+    /* largest reach of the region: r(u) <= r_anchor + L |u - a| and |u - a| <= scale r(u) */
+    q.reach = vpdsi_coverage_reach(s, r_anchor);
+    if (!(q.scale * q.L < 1)) {
         *found = 1;
         return VPDS_OK;
     }
@@ -98,10 +296,13 @@ vpds_status vpdsi_uncovered_in(vpds_sampler *s, const double *alo, const double 
         return VPDS_ERR_OUT_OF_MEMORY;
     }
     if ((st = vpdsi_sync_tree(s)) != VPDS_OK) return st;
+    /* without room for the lists every test reads the kd-trees, as fast as before them */
+    q.lists = vpdsi_mem_reserve(&s->mem, (void **)&s->cand2, &s->cap_cand2, LIST_SLOTS,
+                                sizeof(int32_t)) == 0;
     for (k = 0; k < d; k++) {
         double *bx = s->bb_stack;
-        double lo = alo[k] - reach, hi = ahi[k] + reach;
-        centre[k] = 0.5 * (alo[k] + ahi[k]);
+        double lo = alo[k] - q.reach, hi = ahi[k] + q.reach;
+        q.centre[k] = 0.5 * (alo[k] + ahi[k]);
         if (s->period[k] == 0) { /* uncovered points lie in the box */
             if (lo < s->lo[k]) lo = s->lo[k];
             if (hi > s->hi[k]) hi = s->hi[k];
@@ -110,78 +311,27 @@ vpds_status vpdsi_uncovered_in(vpds_sampler *s, const double *alo, const double 
         bx[d + k] = hi;
         bx[2 * d] = 0;
     }
+    q.slack = list_slack(s, s->bb_stack, s->bb_stack + d);
     top = 1;
-    view = vpdsi_samples_view(s);
+    q.view = vpdsi_samples_view(s);
+    q.uview.x = s->ux;
+    q.uview.r = s->ur;
+    q.uview.flags = s->uf;
     while (top > 0) {
         double *bx = s->bb_stack + --top * stride, lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
-        double p[VPDS_MAX_DIM], gap2 = 0, diag2 = 0, rp, diag, r_lo, r_hi;
-        int depth = (int)bx[2 * d], in_region;
-        int32_t w;
+        int depth = (int)bx[2 * d], verdict;
         memcpy(lo, bx, (size_t)d * sizeof(double));
         memcpy(hi, bx + d, (size_t)d * sizeof(double));
         if (++boxes > UNCOVERED_BUDGET) {
             *found = 1;
             return VPDS_OK;
         }
-        for (k = 0; k < d; k++) {
-            /* nearest point of the box to the anchor's centre, and the box-anchor gap */
-            double g;
-            p[k] = centre[k] < lo[k] ? lo[k] : centre[k] > hi[k] ? hi[k] : centre[k];
-            g = alo[k] > hi[k] ? alo[k] - hi[k] : lo[k] > ahi[k] ? lo[k] - ahi[k] : 0;
-            gap2 += g * g;
-            diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-        }
-        if (gap2 > reach * reach) continue; /* misses the region */
-        if (s->u_ready || s->domain) {
-            double c2[VPDS_MAX_DIM], phi;
-            for (k = 0; k < d; k++) c2[k] = 0.5 * (lo[k] + hi[k]);
-            /* no cell that may hold an uncovered point meets the box */
-            if (s->u_ready && vpdsi_uncovered_nearest(s, c2) > 0.5 * sqrt(diag2) + s->u_half) continue;
-            /* the box lies outside the domain: nothing there needs covering */
-            if (s->domain) {
-                if ((st = vpdsi_domain_at(s, c2, &phi)) != VPDS_OK) return st;
-                if (phi > 0.5 * sqrt(diag2)) continue;
-            }
-        }
-        if ((st = vpdsi_radius_at(s, p, &rp)) != VPDS_OK) return st;
-        if (point) {
-            double f = scale * vpdsi_rule_f(s->rule, r_anchor, rp), d2 = 0;
-            for (k = 0; k < d; k++) d2 += (p[k] - alo[k]) * (p[k] - alo[k]);
-            in_region = d2 <= f * f;
-        } else {
-            double d2 = 0;
-            for (k = 0; k < d; k++) {
-                double g = p[k] < alo[k] ? alo[k] - p[k] : p[k] > ahi[k] ? p[k] - ahi[k] : 0;
-                d2 += g * g;
-            }
-            in_region = d2 <= reach * reach;
-        }
-        if (in_region &&
-            vpdsi_kd_conflict(&s->tree, &view, p, rp, (int)s->rule, scale, -1.0, &w) == -1) {
-            /* p is uncovered: no sample within t*coverage*f of it; a witness if in the domain */
-            double phi = 0;
-            if (s->domain && (st = vpdsi_domain_at(s, p, &phi)) != VPDS_OK) return st;
-            if (phi <= 0) {
-                *found = 1;
-                return VPDS_OK;
-            }
-        }
-        diag = sqrt(diag2);
-        r_lo = rp - L * diag;
-        r_hi = rp + L * diag;
-        s->n_cand2 = 0;
-        if (vpdsi_kd_gather(&s->tree, &view, lo, hi, r_hi, (int)s->rule, scale, 0, &s->mem,
-                            &s->cand2, &s->n_cand2, &s->cap_cand2)) {
-            vpdsi_set_error(s, "out of memory gathering the samples near a box");
-            return VPDS_ERR_OUT_OF_MEMORY;
-        }
-        if (r_lo > 0 && vpdsi_kd_box_covered(&s->tree, &view, s->cand2, s->n_cand2, lo, hi, r_lo,
-                                             (int)s->rule, scale))
-            continue;
-        if (depth >= UNCOVERED_DEPTH || !(diag > 1e-12 * reach)) {
-            *found = 1; /* unresolved at the precision: count it as uncovered */
+        if ((st = examine(&q, lo, hi, depth, &verdict)) != VPDS_OK) return st;
+        if (verdict == 1) {
+            *found = 1;
             return VPDS_OK;
         }
+        if (verdict == 0) continue;
         for (b = 0; b < children; b++) {
             double *cb = s->bb_stack + top++ * stride;
             for (k = 0; k < d; k++) {
