@@ -168,7 +168,7 @@ static int p_covered(bb_search *q, int depth, const double *p, double rp)
 }
 
 /* Whether one sample covers the whole box, r_lo <= r <= r_hi over it (gather, then the test). */
-static vpds_status box_covered(bb_search *q, int depth, const double *lo, const double *hi,
+static vpds_status search_box_covered(bb_search *q, int depth, const double *lo, const double *hi,
                                double r_lo, double r_hi, int *covered)
 {
     vpds_sampler *s = q->s;
@@ -248,7 +248,7 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
             return VPDS_OK;
         }
     }
-    if ((st = box_covered(q, depth, lo, hi, r_lo, r_hi, &covered)) != VPDS_OK) return st;
+    if ((st = search_box_covered(q, depth, lo, hi, r_lo, r_hi, &covered)) != VPDS_OK) return st;
     if (covered) return VPDS_OK;
     /* unresolved at the precision: count it as uncovered */
     *verdict = depth >= UNCOVERED_DEPTH || !(diag > 1e-12 * q->reach) ? 1 : 2;
