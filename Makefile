@@ -88,7 +88,15 @@ $(BUILD)/demo/figure1: examples/figure1.c $(STATIC)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_TEST) $< -o $@ $(STATIC) -lm
 
-check-c: $(TEST_BIN)
+# The Python binding compiles the library as one translation unit (bindings/python/vpds/_build.py):
+# a static name defined in two files breaks its build, and no C test would notice, so check-c
+# compiles that unit too, with the library's flags.
+UNITY_OBJ := $(BUILD)/obj/unity.o
+$(UNITY_OBJ): $(LIB_SRC) $(LIB_HDR)
+	@mkdir -p $(dir $@)
+	printf '#include "%s"\n' vpds.h $(notdir $(LIB_SRC)) | $(CC) $(CFLAGS_LIB) -Ilibvpds -x c -c - -o $@
+
+check-c: $(TEST_BIN) $(UNITY_OBJ)
 	@set -e; for t in $(TEST_BIN); do echo "== $$t"; $$t; done
 
 check-flann: $(FLANN_TEST)
