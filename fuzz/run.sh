@@ -35,8 +35,8 @@ for f in "$@"; do
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
   slow=$(sed -n 's/^stat::slowest_unit_time_sec: *//p' "$log" | tail -1)
-  summary=$(printf 'fuzz_%-9s %9s runs in %3d s, %6s exec/s, slowest input %s s' "$f" "${runs:-?}" \
-    "$took" "${rate:-?}" "${slow:-?}")
+  summary=$(printf 'fuzz_%-9s %9s runs in %3d s, %6s exec/s' "$f" "${runs:-?}" "$took" "${rate:-?}")
+  [ "${slow:-0}" -gt 0 ] 2> /dev/null && summary="$summary, slowest input $slow s"
   if [ $rc = 0 ] && [ -n "$runs" ]; then
     echo "$summary: OK"
     continue
@@ -48,8 +48,11 @@ for f in "$@"; do
     *) why="exit status $rc" ;;
   esac
   echo "$summary: FAIL ($why; full log $log)"
-  # the report: from the first error line on (sanitizer, libFuzzer, harness invariant)
-  awk '/ERROR|invariant broken|runtime error/ { on = 1 } on' "$log" | head -n 40 | sed 's/^/    /'
+  # the report: from the first error line on (sanitizer, libFuzzer, harness invariant), without
+  # the frames of libFuzzer's own loop and of the C runtime
+  awk '/ERROR|invariant broken|runtime error/ { on = 1 } on' "$log" |
+    grep -Ev ' in (fuzzer::|__sanitizer_print_stack_trace|__libc_start|_start |main )' |
+    head -n 40 | sed 's/^/    /'
   sed -n 's/.*Test unit written to \(.*\)/    artifact: \1/p' "$log"
 done
 if [ ${#failed[@]} -gt 0 ]; then

@@ -35,6 +35,11 @@ typedef struct {
     int point, lists; /* lists: the slots are allocated */
     vpdsi_kd_samples view, uview;
     bb_lists lv[UNCOVERED_DEPTH + 1];
+    /* the box being examined: kept here, not in the helpers' frames, which then cost nothing
+     * to enter under AddressSanitizer (the fuzz builds examine millions of boxes) */
+    double p[VPDS_MAX_DIM], c2[VPDS_MAX_DIM], rp, phi;
+    size_t count;
+    int32_t w;
 } bb_search;
 
 double vpdsi_coverage_reach(const vpds_sampler *s, double r_hi)
@@ -108,16 +113,17 @@ static int near_uncovered(bb_search *q, int depth, const double *c2, double thr)
 {
     vpds_sampler *s = q->s;
     bb_lists *me = &q->lv[depth];
-    size_t off = slot(depth, 0), count = off;
+    size_t off = slot(depth, 0);
+    q->count = off;
     if (q->lists && depth > 0 && q->lv[depth - 1].u_ok) {
         me->u_n = vpdsi_kd_filter_near(&s->utree, &q->uview, s->cand2 + slot(depth - 1, 0),
                                        q->lv[depth - 1].u_n, c2, c2, 0.0, thr, q->slack,
                                        s->cand2 + off);
         me->u_ok = 1;
     } else if (q->lists && vpdsi_kd_near_box(&s->utree, &q->uview, c2, c2, 0.0, thr, q->slack,
-                                             LIST_CAP, &s->mem, &s->cand2, &count,
+                                             LIST_CAP, &s->mem, &s->cand2, &q->count,
                                              &s->cap_cand2) == 0) {
-        me->u_n = count - off;
+        me->u_n = q->count - off;
         me->u_ok = 1;
     }
     if (!me->u_ok) return !(vpdsi_uncovered_nearest(s, c2) > thr);
@@ -133,7 +139,7 @@ static void sample_list(bb_search *q, int depth, const double *lo, const double 
 {
     vpds_sampler *s = q->s;
     bb_lists *me = &q->lv[depth], *up = depth > 0 ? &q->lv[depth - 1] : NULL;
-    size_t off = slot(depth, 1), count = off;
+    size_t off = slot(depth, 1);
     double rb = r_hi + q->L * diag;
     if (!q->lists) return;
     if (s->tree.n_nodes == 0) { /* no sample: the empty list is complete for any r */
@@ -147,9 +153,10 @@ static void sample_list(bb_search *q, int depth, const double *lo, const double 
         me->s_n = vpdsi_kd_filter_near(&s->tree, &q->view, s->cand2 + slot(depth - 1, 1), up->s_n,
                                        lo, hi, rb, q->scale, q->slack, s->cand2 + off);
         me->s_ok = 1;
-    } else if (vpdsi_kd_near_box(&s->tree, &q->view, lo, hi, rb, q->scale, q->slack, LIST_CAP,
-                                 &s->mem, &s->cand2, &count, &s->cap_cand2) == 0) {
-        me->s_n = count - off;
+    } else if ((q->count = off,
+                vpdsi_kd_near_box(&s->tree, &q->view, lo, hi, rb, q->scale, q->slack, LIST_CAP,
+                                  &s->mem, &s->cand2, &q->count, &s->cap_cand2)) == 0) {
+        me->s_n = q->count - off;
         me->s_ok = 1;
     }
     me->r_bound = rb;
@@ -159,12 +166,11 @@ static void sample_list(bb_search *q, int depth, const double *lo, const double 
 static int p_covered(bb_search *q, int depth, const double *p, double rp)
 {
     vpds_sampler *s = q->s;
-    int32_t w;
     if (q->lv[depth].s_ok)
         return q->lv[depth].s_n > 0 &&
                vpdsi_kd_list_conflict(&s->tree, &q->view, s->cand2 + slot(depth, 1),
                                       q->lv[depth].s_n, p, rp, (int)s->rule, q->scale);
-    return vpdsi_kd_conflict(&s->tree, &q->view, p, rp, (int)s->rule, q->scale, -1.0, &w) != -1;
+    return vpdsi_kd_conflict(&s->tree, &q->view, p, rp, (int)s->rule, q->scale, -1.0, &q->w) != -1;
 }
 
 /* Whether one sample covers the whole box, r_lo <= r <= r_hi over it (gather, then the test). */
@@ -198,9 +204,8 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
                            int *verdict)
 {
     vpds_sampler *s = q->s;
-    int d = s->dim, k, in_region, covered;
-    double p[VPDS_MAX_DIM], c2[VPDS_MAX_DIM], gap2 = 0, diag2 = 0, rp, diag, r_lo, r_hi;
-    double phi_c = -INFINITY;
+    int d = s->dim, k, in_region;
+    double *p = q->p, *c2 = q->c2, gap2 = 0, diag2 = 0, diag, r_lo, r_hi;
     vpds_status st;
     *verdict = 0;
     q->lv[depth].u_ok = q->lv[depth].s_ok = 0;
@@ -211,19 +216,22 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
         g = q->alo[k] > hi[k] ? q->alo[k] - hi[k] : lo[k] > q->ahi[k] ? lo[k] - q->ahi[k] : 0;
         gap2 += g * g;
         diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+        c2[k] = 0.5 * (lo[k] + hi[k]);
     }
     if (gap2 > q->reach * q->reach) return VPDS_OK; /* misses the region */
-    for (k = 0; k < d; k++) c2[k] = 0.5 * (lo[k] + hi[k]);
     /* no cell that may hold an uncovered point meets the box */
     if (s->u_ready && !near_uncovered(q, depth, c2, 0.5 * sqrt(diag2) + s->u_half)) return VPDS_OK;
     /* the box lies outside the domain: nothing there needs covering */
     if (s->domain) {
-        if ((st = vpdsi_domain_at(s, c2, &phi_c)) != VPDS_OK) return st;
-        if (phi_c > 0.5 * sqrt(diag2)) return VPDS_OK;
+        if ((st = vpdsi_domain_at(s, c2, &q->phi)) != VPDS_OK) return st;
+        if (q->phi > 0.5 * sqrt(diag2)) return VPDS_OK;
     }
-    if ((st = vpdsi_radius_at(s, p, &rp)) != VPDS_OK) return st;
+    if (s->sizing.kind == VPDSI_SIZING_CONSTANT)
+        q->rp = s->sizing.radius; /* what vpdsi_radius_at answers, without its frame */
+    else if ((st = vpdsi_radius_at(s, p, &q->rp)) != VPDS_OK)
+        return st;
     if (q->point) {
-        double f = q->scale * vpdsi_rule_f(s->rule, q->r_anchor, rp), d2 = 0;
+        double f = q->scale * vpdsi_rule_f(s->rule, q->r_anchor, q->rp), d2 = 0;
         for (k = 0; k < d; k++) d2 += (p[k] - q->alo[k]) * (p[k] - q->alo[k]);
         in_region = d2 <= f * f;
     } else {
@@ -236,20 +244,23 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
         in_region = d2 <= q->reach * q->reach;
     }
     diag = sqrt(diag2);
-    r_lo = rp - q->L * diag;
-    r_hi = rp + q->L * diag;
-    sample_list(q, depth, lo, hi, rp, r_hi, diag);
-    if (in_region && !p_covered(q, depth, p, rp)) {
+    r_lo = q->rp - q->L * diag;
+    r_hi = q->rp + q->L * diag;
+    sample_list(q, depth, lo, hi, q->rp, r_hi, diag);
+    if (in_region && !p_covered(q, depth, p, q->rp)) {
         /* p is uncovered: no sample within t*coverage*f of it; a witness if in the domain */
-        double phi = 0;
-        if (s->domain && (st = vpdsi_domain_at(s, p, &phi)) != VPDS_OK) return st;
-        if (phi <= 0) {
+        q->phi = 0;
+        if (s->domain && (st = vpdsi_domain_at(s, p, &q->phi)) != VPDS_OK) return st;
+        if (q->phi <= 0) {
             *verdict = 1;
             return VPDS_OK;
         }
     }
-    if ((st = search_box_covered(q, depth, lo, hi, r_lo, r_hi, &covered)) != VPDS_OK) return st;
-    if (covered) return VPDS_OK;
+    if ((st = search_box_covered(q, depth, lo, hi, r_lo, r_hi, verdict)) != VPDS_OK) return st;
+    if (*verdict) { /* inside one coverage disk */
+        *verdict = 0;
+        return VPDS_OK;
+    }
     /* unresolved at the precision: count it as uncovered */
     *verdict = depth >= UNCOVERED_DEPTH || !(diag > 1e-12 * q->reach) ? 1 : 2;
     return VPDS_OK;
