@@ -127,7 +127,7 @@ fuzz: $(FUZZERS:%=$(FUZZ_OUT)/fuzz_%)
 check-fuzz: $(FUZZERS:%=$(BUILD)/fuzz/replay_%) check-fuzz-fails
 	@set -e; for f in $(FUZZERS); do printf '%-24s' "replay corpus/$$f:"; \
 	  $(BUILD)/fuzz/replay_$$f fuzz/corpus/$$f; done
-	@$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(FUZZ_TEST_SECONDS) FUZZ_CORPUS=fresh
+	@FUZZ_SLOW=report $(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(FUZZ_TEST_SECONDS) FUZZ_CORPUS=fresh
 
 check-fuzz-fails: $(FUZZ_LIB_OBJ)
 	@bash tests/fuzz_fails.sh $(BUILD)

