@@ -16,27 +16,12 @@ import numpy as np
 
 from ._core import RULES, PoissonDisk, VpdsError
 from ._optional import MissingDependencyError, require
-from .cli_common import UsageError, floats_arg, periodic_arg, sizing_from_expression
+from .cli_common import UsageError, domain_from_file, floats_arg, periodic_arg, sizing_from_expression
 from .estimate import available_memory, estimate_run
 from .files import check_output, write_points
 
 # the progress bar advances by this many samples per call into the library
 _STEP = 20_000
-
-
-def domain_from_file(path: Path) -> Any:
-    """--domain FILE: an image (.png, .exr, ...: a mask over the box), a .npy array (a mask
-    with one axis per dimension, or (m, 2) polygon vertices), or a .wkt polygon (shapely)."""
-    if not path.is_file():
-        raise UsageError(f"--domain {path}: no such file")
-    try:
-        if path.suffix.lower() == ".npy":
-            return np.load(path, allow_pickle=False)
-        if path.suffix.lower() == ".wkt":
-            return require("shapely.wkt", "--domain .wkt", "shapely").loads(path.read_text())
-    except (OSError, ValueError) as exc:
-        raise UsageError(f"--domain {path}: cannot read it: {exc}") from None
-    return str(path)
 
 
 def _sizing(args: argparse.Namespace, lo: np.ndarray, hi: np.ndarray) -> tuple[Any, dict, dict]:

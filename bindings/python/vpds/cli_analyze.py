@@ -16,7 +16,7 @@ import numpy as np
 
 from ._core import RULES
 from ._optional import require
-from .cli_common import UsageError, floats_arg, sizing_from_expression
+from .cli_common import UsageError, domain_from_file, floats_arg, sizing_from_expression
 from .files import Record, read_points
 
 EXIT_FAILED, EXIT_UNCHECKED = 1, 3
@@ -125,7 +125,6 @@ def _maximal(rec: Record, p: Params, analysis: Any) -> Check:
 
 def _maximal_in_domain(rec: Record, p: Params, analysis: Any, name: str, s_c: float) -> Check:
     """Probes of the domain only: the branch-and-bound covers boxes, not a domain's boundary."""
-    from .cli import domain_from_file
     from .domain import as_domain
     dom = as_domain(domain_from_file(Path(p.domain)), p.dim, p.lo, p.hi, p.domain_threshold)
     rng = np.random.default_rng(0)

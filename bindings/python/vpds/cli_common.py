@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import ast
 import math
-from typing import Callable, Optional
+from pathlib import Path
+from typing import Any, Callable, Optional
 
 import numpy as np
 
-__all__ = ["UsageError", "floats_arg", "periodic_arg", "sizing_from_expression", "EXPR_NAMES"]
+from ._optional import require
+
+__all__ = ["UsageError", "domain_from_file", "floats_arg", "periodic_arg", "sizing_from_expression", "EXPR_NAMES"]
 
 
 class UsageError(Exception):
@@ -86,3 +89,18 @@ def periodic_arg(text: Optional[str], dim: int) -> Optional[list]:
     if bad:
         raise UsageError(f"--periodic {text!r}: axis {bad[0]} is not in 0..{dim - 1}")
     return [k in axes for k in range(dim)]
+
+
+def domain_from_file(path: Path) -> Any:
+    """--domain FILE: an image (.png, .exr, ...: a mask over the box), a .npy array (a mask
+    with one axis per dimension, or (m, 2) polygon vertices), or a .wkt polygon (shapely)."""
+    if not path.is_file():
+        raise UsageError(f"--domain {path}: no such file")
+    try:
+        if path.suffix.lower() == ".npy":
+            return np.load(path, allow_pickle=False)
+        if path.suffix.lower() == ".wkt":
+            return require("shapely.wkt", "--domain .wkt", "shapely").loads(path.read_text())
+    except (OSError, ValueError) as exc:
+        raise UsageError(f"--domain {path}: cannot read it: {exc}") from None
+    return str(path)
