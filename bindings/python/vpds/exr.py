@@ -44,7 +44,7 @@ def sizing_grid_from_exr(path: Union[str, PathLike], lo: Sequence[float], hi: Se
                          channel: Optional[str] = None,
                          radius_range: Optional[Sequence[float]] = None):
     """A SizingGrid over [lo, hi] from an image (see the module's note on orientation)."""
-    from ._core import SizingGrid
+    from .sizing_grid import SizingGrid
     if len(lo) != 2:
         raise ValueError(f"an image sizes a 2D box; the box has {len(lo)} axes")
     pixels = read_channel(path, channel)
