@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # The same seed gives byte-identical points across compilers (gcc, clang), optimisation levels
-# (-O0, -O3) and sanitizer builds, and the same bytes as the golden outputs committed for
-# algorithm version 1 (tests/golden/v1.sha256). UPDATE_GOLDEN=1 rewrites them (only when
-# VPDS_ALGORITHM_VERSION changes).
+# (-O0, -O3) and sanitizer builds, and, for every algorithm version N this library has, the
+# same bytes as the golden outputs committed for it (tests/golden/vN.sha256, each configuration
+# run with desc.algorithm_version = N): a world generated from a seed does not change on
+# upgrade. UPDATE_GOLDEN=N rewrites the file of version N only (when that version is new).
 set -euo pipefail
 out=${1:-build/determinism}
 mkdir -p "$out"
-golden=tests/golden/v1.sha256
+current=$(sed -n 's/^#define VPDS_ALGORITHM_VERSION \([0-9]*\).*/\1/p' include/vpds.h)
 configs=(
   "2 smaller const 0.02 1 0 1"
   "1 bigger ramp 0 2 0 1"
@@ -14,6 +15,12 @@ configs=(
   "2 current radial 0 4 0.5 0.6"
   "4 smaller const 0.2 5 0 1"
   "2 smaller mild 0 6 0 1 0 1"
+  # two radii, a domain, periodic axes: the coverage search that version 2 changed
+  "3 bigger steep 0 7 0 0.7 inhibition=0.5 periodic=6"
+  "2 smaller const 0.03 8 0 1 inhibition=0.5 domain=ball"
+  "2 current mild 0 9 0 1 inhibition=0.6"
+  "3 smaller const 0.12 10 0 1 domain=ball"
+  "2 prior steep 0 11 0 1 0 0 inhibition=0.4 periodic=2 domain=ball"
 )
 variants=("gcc -O0" "gcc -O3" "clang -O0" "clang -O3" "gcc -O1 -fsanitize=address,undefined")
 # the library's own flags: no FMA contraction, no fast-math
@@ -24,24 +31,39 @@ for v in "${variants[@]}"; do
   $v $common libvpds/*.c tests/tools/sample_tool.c -lm -o "$out/tool_$name"
 done
 status=0
-: > "$out/actual.sha256"
-i=0
-for c in "${configs[@]}"; do
-  i=$((i + 1))
-  ref=""
-  for v in "${variants[@]}"; do
-    name=$(echo "$v" | tr ' =,' '___')
-    "$out/tool_$name" "$out/out_${i}_$name.bin" $c > /dev/null
-    h=$(sha256sum "$out/out_${i}_$name.bin" | cut -d' ' -f1)
-    if [ -z "$ref" ]; then ref=$h; elif [ "$h" != "$ref" ]; then
-      echo "determinism: config '$c' differs between builds ($v)" >&2; status=1
-    fi
+runs=0
+for version in $(seq 1 "$current"); do
+  golden=tests/golden/v$version.sha256
+  actual=$out/actual_v$version.sha256
+  : > "$actual"
+  i=0
+  for c in "${configs[@]}"; do
+    i=$((i + 1))
+    ref=""
+    for v in "${variants[@]}"; do
+      name=$(echo "$v" | tr ' =,' '___')
+      # shellcheck disable=SC2086 # a configuration is a list of arguments
+      "$out/tool_$name" "$out/out_v${version}_${i}_$name.bin" $c "version=$version" > /dev/null
+      runs=$((runs + 1))
+      h=$(sha256sum "$out/out_v${version}_${i}_$name.bin" | cut -d' ' -f1)
+      if [ -z "$ref" ]; then ref=$h; elif [ "$h" != "$ref" ]; then
+        echo "determinism: version $version, config '$c' differs between builds ($v)" >&2
+        status=1
+      fi
+    done
+    echo "$ref  $c" >> "$actual"
   done
-  echo "$ref  $c" >> "$out/actual.sha256"
+  if [ "${UPDATE_GOLDEN:-0}" = "$version" ]; then
+    cp "$actual" "$golden"
+    echo "golden outputs of version $version rewritten"
+  fi
+  if [ ! -f "$golden" ]; then
+    echo "determinism: $golden is missing (UPDATE_GOLDEN=$version writes it)" >&2
+    status=1
+  elif ! diff -u "$golden" "$actual"; then
+    echo "determinism: output differs from the golden outputs of algorithm version $version" >&2
+    status=1
+  fi
 done
-if [ "${UPDATE_GOLDEN:-0}" = 1 ]; then cp "$out/actual.sha256" "$golden"; echo "golden outputs rewritten"; fi
-if ! diff -u "$golden" "$out/actual.sha256"; then
-  echo "determinism: output differs from the golden outputs of algorithm version 1" >&2; status=1
-fi
-[ $status = 0 ] && echo "summary: ${#configs[@]} configurations, ${#variants[@]} builds each, identical bytes, matching the golden outputs"
+[ $status = 0 ] && echo "summary: versions 1..$current, ${#configs[@]} configurations each, ${#variants[@]} builds each ($runs runs), identical bytes, matching the golden outputs"
 exit $status

@@ -1,8 +1,11 @@
 /* Samples one named configuration and writes it for the independent checkers in tests/py:
  * int64 n, int64 dim, then n*dim doubles x, n radii, n scales t.
- * usage: sample_tool OUT dim rule sizing radius seed lo hi [budget [weighted]]
- *   rule: prior|current|bigger|smaller; sizing: const|ramp|radial (the paper's Figures 1, 10)
- *   or mild (0.04 + 0.04 x); weighted: 1 for the weighted-bias-free process (Eq. 12) */
+ * usage: sample_tool OUT dim rule sizing radius seed lo hi [budget [weighted]] [KEY=VALUE...]
+ *   rule: prior|current|bigger|smaller; sizing: const|ramp|radial (the paper's Figures 1, 10),
+ *   mild (0.04 + 0.04 x) or steep (0.05 + 0.2 x, the fuzzers' ramp); weighted: 1 for the
+ *   weighted-bias-free process (Eq. 12)
+ *   KEY=VALUE: inhibition=F (two radii), periodic=MASK (bit k: axis k), domain=ball (the ball
+ *   of radius 0.4 about the box centre), version=N (desc.algorithm_version) */
 #include "vpds.h"
 #include <math.h>
 #include <stdio.h>
@@ -11,6 +14,14 @@
 
 static double ramp(const double *x, void *u) { (void)u; return 0.001 + 0.3 * x[0]; }
 static double mild(const double *x, void *u) { (void)u; return 0.04 + 0.04 * x[0]; }
+static double steep(const double *x, void *u) { (void)u; return 0.05 + 0.2 * fabs(x[0]); }
+static double ball(const double *x, void *u)
+{
+    int dim = *(int *)u, k;
+    double d2 = 0;
+    for (k = 0; k < dim; k++) d2 += (x[k] - 0.5) * (x[k] - 0.5);
+    return sqrt(d2) - 0.4;
+}
 static double radial(const double *x, void *u)
 {
     int dim = *(int *)u, k;
@@ -25,7 +36,7 @@ int main(int argc, char **argv)
     vpds_sampler *s;
     vpds_status st;
     double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
-    int dim, k;
+    int dim, k, periodic[VPDS_MAX_DIM] = {0}, positional = argc, a;
     FILE *f;
     long long hdr[2];
     vpds_stats stats;
@@ -33,6 +44,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: %s OUT dim rule sizing radius seed lo hi [budget]\n", argv[0]);
         return 2;
     }
+    for (a = 9; a < argc; a++)
+        if (strchr(argv[a], '=') && positional == argc) positional = a;
     dim = atoi(argv[2]);
     d.dim = dim;
     for (k = 0; k < dim && k < VPDS_MAX_DIM; k++) {
@@ -53,14 +66,34 @@ int main(int argc, char **argv)
         d.sizing = mild;
         d.lipschitz = 0.04;
         d.radius_min = 0.04;
+    } else if (!strcmp(argv[4], "steep")) {
+        d.sizing = steep;
+        d.lipschitz = 0.2;
     } else if (!strcmp(argv[4], "radial")) {
         d.sizing = radial;
         d.sizing_user = &dim;
         d.lipschitz = 0.01485 * 8 * 3.14159265358979323846 * (1 + 1e-9);
     }
     d.seed = strtoull(argv[6], NULL, 10);
-    if (argc > 9) d.budget = strtoull(argv[9], NULL, 10);
-    if (argc > 10) d.weighted = atoi(argv[10]);
+    if (positional > 9) d.budget = strtoull(argv[9], NULL, 10);
+    if (positional > 10) d.weighted = atoi(argv[10]);
+    for (a = positional; a < argc; a++) {
+        const char *v = strchr(argv[a], '=') + 1;
+        if (!strncmp(argv[a], "inhibition=", 11)) {
+            d.inhibition = atof(v);
+        } else if (!strncmp(argv[a], "periodic=", 9)) {
+            for (k = 0; k < dim && k < VPDS_MAX_DIM; k++) periodic[k] = (atoi(v) >> k) & 1;
+            d.periodic = periodic;
+        } else if (!strcmp(argv[a], "domain=ball")) {
+            d.domain = ball;
+            d.domain_user = &dim;
+        } else if (!strncmp(argv[a], "version=", 8)) {
+            d.algorithm_version = (uint32_t)atoi(v);
+        } else {
+            fprintf(stderr, "sample_tool: unknown option '%s'\n", argv[a]);
+            return 2;
+        }
+    }
     if ((st = vpds_create(&d, &s)) != VPDS_OK) {
         char msg[512];
         vpds_validate(&d, msg, sizeof msg);
