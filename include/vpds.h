@@ -39,8 +39,10 @@ extern "C" {
 #define VPDS_VERSION_MAJOR 1
 #define VPDS_VERSION_MINOR 0
 #define VPDS_VERSION_PATCH 0
-/* The points a seed gives are fixed for one algorithm version; pin it in vpds_desc to keep them. */
-#define VPDS_ALGORITHM_VERSION 1
+/* The points a seed gives are fixed for one algorithm version; pin it in vpds_desc to keep them.
+ * 1: 1.0.0. 2: the two-radii and domain coverage search drops what it used to keep only for
+ * want of precision (same guarantees; other points with two radii or a domain). */
+#define VPDS_ALGORITHM_VERSION 2
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 8
 /* Relative tolerance eps of the continuous stream (vpds_next): each t it reports is an upper

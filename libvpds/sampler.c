@@ -120,6 +120,7 @@ vpds_status vpds_create(const vpds_desc *d, vpds_sampler **out)
     s->inhibition = d->inhibition;
     s->coverage = d->coverage;
     s->two_radii = d->inhibition < d->coverage;
+    s->algorithm = d->algorithm_version ? d->algorithm_version : VPDS_ALGORITHM_VERSION;
     for (k = 0; k < d->dim; k++) {
         s->period[k] = d->periodic && d->periodic[k] ? s->hi[k] - s->lo[k] : 0.0;
         if (s->period[k] > 0) s->any_periodic = 1;

@@ -45,6 +45,7 @@ struct vpds_sampler {
     vpds_rule rule;
     double inhibition, coverage;
     int two_radii;                 /* inhibition < coverage (Section 3) */
+    unsigned algorithm;            /* desc.algorithm_version, 0 resolved to the current one */
     double period[VPDS_MAX_DIM];   /* box side on a periodic axis, 0 on an open one */
     int any_periodic;
     int weighted;

@@ -212,3 +212,23 @@ def test_callable_sampled_onto_a_grid_is_an_approximation_with_its_own_l():
     assert np.abs(engine.radii - f(x)).max() < 1e-3  # close to the callable, not equal
     with pytest.raises(ValueError, match="samples a callable"):
         vpds.PoissonDisk(2, sizing=0.1, sizing_grid_shape=(3, 3))
+
+
+def test_algorithm_version_pins_the_points():
+    """Version 1 keeps the points made before version 2 changed the two-radii coverage search;
+    one radius is the same under both; a version the library does not have is refused."""
+    assert vpds.ALGORITHM_VERSION == 2
+
+    def fill(version, inhibition):
+        engine = vpds.PoissonDisk(2, sizing=lambda x: 0.04 + 0.04 * x[:, 0], lipschitz=0.04,
+                                  rule="current", inhibition=inhibition, seed=9, progress=False,
+                                  algorithm_version=version)
+        return engine.fill_space()
+
+    current, v1, v2 = fill(None, 0.6), fill(1, 0.6), fill(2, 0.6)
+    assert np.array_equal(current, v2)
+    assert not np.array_equal(v1, v2)
+    assert np.array_equal(fill(1, 1.0), fill(2, 1.0))
+    for bad in (3, -1, 1.5, True):
+        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.2"):
+            vpds.PoissonDisk(2, algorithm_version=bad)

@@ -29,6 +29,7 @@ ffibuilder.cdef(declarations_from_header(ROOT / "include" / "vpds.h"))
 # floating-point macros of vpds.h (cffi reads only integer #defines by itself)
 ffibuilder.cdef("static const double VPDS_STREAM_TOLERANCE;")
 ffibuilder.cdef("static const double VPDS_STREAM_DOMAIN_TOLERANCE;")
+ffibuilder.cdef("#define VPDS_ALGORITHM_VERSION ...")
 # the batched sizing callback that runs Python code (see vpds._core.vpds_py_sizing_batch)
 ffibuilder.cdef('''extern "Python" int vpds_py_sizing_batch(const double *x, size_t n, double *r_out,
                                                       void *user);''')

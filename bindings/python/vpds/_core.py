@@ -16,8 +16,10 @@ from ._scipy_compat import _optimization_name, _scipy_optimizers, _seed_from, _v
 from .sizing_grid import SizingGrid
 
 __all__ = ["PoissonDisk", "SizingGrid", "VpdsError", "VpdsSizingError", "VpdsDomainError",
-           "Progressive", "RULES"]
+           "Progressive", "RULES", "ALGORITHM_VERSION"]
 
+#: the algorithm version of this library: the points a seed gives (`algorithm_version` pins one)
+ALGORITHM_VERSION: int = int(lib.VPDS_ALGORITHM_VERSION)
 RULES = {"prior": lib.VPDS_RULE_PRIOR, "current": lib.VPDS_RULE_CURRENT,
          "bigger": lib.VPDS_RULE_BIGGER, "smaller": lib.VPDS_RULE_SMALLER}
 # work units (darts + cells) per C call in a fill: small enough for a responsive Ctrl-C and
@@ -105,6 +107,9 @@ class PoissonDisk:
                   over the box (inside: value >= domain_threshold), or an image file (.exr,
                   .png, ...). See vpds.domain.
       progress:   a tqdm bar during fill_space (if tqdm is installed).
+      algorithm_version: pin the points a seed gives (None or 0: the library's current
+                  version, `vpds.ALGORITHM_VERSION`); 1 reproduces worlds made before
+                  version 2 changed the coverage search of two radii.
     Results are numpy arrays of shape (n, d) (copies: they outlive the sampler).
     """
 
@@ -121,7 +126,7 @@ class PoissonDisk:
                  seed: Any = None, sizing_channel: Optional[str] = None,
                  sizing_range: Optional[Sequence[float]] = None,
                  sizing_grid_shape: Optional[Sequence[int]] = None, domain: Any = None,
-                 domain_threshold: float = 0.5):
+                 domain_threshold: float = 0.5, algorithm_version: Optional[int] = None):
         if seed is not None and rng is not None:
             raise TypeError("PoissonDisk() got multiple values for argument now known as `rng`. "
                             "Specify one of `rng` or `seed`.")
@@ -207,6 +212,12 @@ class PoissonDisk:
         desc.inhibition = float(inhibition)
         desc.coverage = float(coverage)
         desc.weighted = 1 if weighted else 0
+        if algorithm_version is not None:
+            if (not isinstance(algorithm_version, (int, np.integer)) or isinstance(algorithm_version, bool)
+                    or not 0 <= algorithm_version <= ALGORITHM_VERSION):
+                raise ValueError(f"algorithm_version = {algorithm_version!r}: this library has "
+                                 f"versions 1..{ALGORITHM_VERSION} (0 or None: the current one)")
+            desc.algorithm_version = int(algorithm_version)
         if radius_min is not None:
             desc.radius_min = float(radius_min)
         if radius_max is not None:
