@@ -1,8 +1,9 @@
 # libvpds: every entry point of the project. `make test` is what CI runs.
 CC      ?= gcc
 PREFIX  ?= /usr/local
-VERSION := 1.0.0
-SOMAJOR := 1
+# the version lives in include/vpds.h (CMake and the Python package read it there too)
+VERSION := $(shell sed -n 's/^\#define VPDS_VERSION_\(MAJOR\|MINOR\|PATCH\) \([0-9]*\).*/\2/p' include/vpds.h | paste -sd.)
+SOMAJOR := $(firstword $(subst ., ,$(VERSION)))
 BUILD   ?= build
 OPT     ?= -O2
 WARN    := -std=c99 -Wall -Wextra -Wpedantic -Werror
@@ -10,7 +11,8 @@ WARN    := -std=c99 -Wall -Wextra -Wpedantic -Werror
 CFLAGS_LIB := $(WARN) $(OPT) -g -fPIC -fvisibility=hidden -ffp-contract=off -Iinclude $(EXTRA_CFLAGS)
 CFLAGS_TEST := $(WARN) $(OPT) -g -ffp-contract=off -Iinclude -Ilibvpds -Itests $(EXTRA_CFLAGS)
 
-LIB_SRC := $(sort $(wildcard libvpds/*.c))
+# the one list of sources, which CMakeLists.txt and tools/amalgamate.py read too
+LIB_SRC := $(addprefix libvpds/,$(shell cat libvpds/sources.txt))
 LIB_OBJ := $(LIB_SRC:libvpds/%.c=$(BUILD)/obj/%.o)
 LIB_HDR := include/vpds.h $(wildcard libvpds/*.h)
 SHARED  := $(BUILD)/libvpds.so.$(VERSION)
@@ -51,7 +53,7 @@ PKG_SRC := bindings/python/pyproject.toml bindings/python/setup.py $(wildcard bi
 VALGRIND := valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect
 
 .PHONY: all test demo deps install clean bench check-c check-flann check-py check-sanitizers check-abi \
-	check-valgrind check-determinism check-fuzz check-fuzz-fails fuzz
+	check-valgrind check-determinism check-fuzz check-fuzz-fails fuzz amalgamate check-consumers
 all: $(SHARED) $(STATIC) $(BUILD)/vpds.pc
 
 $(BUILD)/obj/%.o: libvpds/%.c $(LIB_HDR)
@@ -97,6 +99,8 @@ $(UNITY_OBJ): $(LIB_SRC) $(LIB_HDR)
 	printf '#include "%s"\n' vpds.h $(notdir $(LIB_SRC)) | $(CC) $(CFLAGS_LIB) -Ilibvpds -x c -c - -o $@
 
 check-c: $(TEST_BIN) $(UNITY_OBJ)
+	@test "$(sort $(wildcard libvpds/*.c))" = "$(sort $(LIB_SRC))" || \
+	  { echo "libvpds/sources.txt does not list exactly the files libvpds/*.c"; exit 1; }
 	@set -e; for t in $(TEST_BIN); do echo "== $$t"; $$t; done
 
 check-flann: $(FLANN_TEST)
@@ -142,6 +146,17 @@ check-abi: all
 	bash tests/abi_check.sh $(BUILD)
 	bash tests/readme_quickstart.sh $(BUILD)
 
+# The single-file build: build/amalgamated/vpds.c beside a copy of include/vpds.h.
+amalgamate: $(BUILD)/amalgamated/vpds.c
+$(BUILD)/amalgamated/vpds.c: libvpds/sources.txt $(LIB_SRC) $(LIB_HDR) tools/amalgamate.py
+	python3 tools/amalgamate.py $@
+	cp include/vpds.h $(BUILD)/amalgamated/vpds.h
+
+# Engines' ways in (CMake package, add_subdirectory, single file), against the Makefile's bytes.
+check-consumers: all $(SAMPLE_TOOL)
+	bash tests/readme_quickstart.sh $(BUILD)
+	bash tests/consumers.sh $(BUILD)
+
 $(PY):
 	bash tools/venv.sh $(VENV)
 
@@ -174,6 +189,7 @@ test: $(DEPS_STAMP)
 	@$(PHASE) c-tests $(SUBMAKE) check-c
 	@$(PHASE) abi+readme $(SUBMAKE) check-abi
 	@$(PHASE) flann $(SUBMAKE) check-flann
+	@$(PHASE) consumers $(SUBMAKE) check-consumers
 	@$(PHASE) sanitizers $(SUBMAKE) check-sanitizers
 	@$(PHASE) valgrind $(SUBMAKE) check-valgrind
 	@$(PHASE) determinism $(SUBMAKE) check-determinism

@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 py=${1:?usage: tools/deps.sh PYTHON}
 missing=()
-for pkg in libflann-dev clang libclang-rt-14-dev valgrind pkg-config; do
+for pkg in libflann-dev clang libclang-rt-14-dev valgrind pkg-config cmake; do
   dpkg -s "$pkg" >/dev/null 2>&1 || missing+=("$pkg")
 done
 if [ ${#missing[@]} -gt 0 ]; then
