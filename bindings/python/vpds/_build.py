@@ -10,7 +10,8 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent.parent  # bindings/python/vpds -> repository root
 # The library's sources are compiled into the extension as one translation unit (their static
 # names do not clash): setuptools would refuse them as sources outside this directory.
-UNITY = "\n".join(f'#include "{p.name}"' for p in sorted((ROOT / "libvpds").glob("*.c")))
+# libvpds/sources.txt: the one list of the library's sources (the Makefile and CMake read it too)
+UNITY = "\n".join(f'#include "{name}"' for name in (ROOT / "libvpds" / "sources.txt").read_text().split())
 
 
 
@@ -39,6 +40,9 @@ ffibuilder.set_source(
     "vpds._vpds",
     '#include "vpds.h"\n' + UNITY,
     include_dirs=[str(ROOT / "include"), str(ROOT / "libvpds")],
+    # the sources the unit includes: a change to one alone rebuilds the extension (setuptools
+    # compares the generated file's time only, which a C-only change leaves as it was)
+    depends=[str(p) for p in sorted((ROOT / "libvpds").glob("*.[ch]"))] + [str(ROOT / "include" / "vpds.h")],
     # the library's determinism contract: no FMA contraction, no fast-math
     extra_compile_args=["-std=c99", "-O2", "-ffp-contract=off", "-fvisibility=hidden"],
 )
