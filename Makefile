@@ -19,7 +19,9 @@ SHARED  := $(BUILD)/libvpds.so.$(VERSION)
 STATIC  := $(BUILD)/libvpds.a
 
 TEST_SRC := $(sort $(wildcard tests/test_*.c))
-TEST_BIN := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
+# the longest first, so that the programs run side by side finish together
+TEST_SLOW := $(BUILD)/tests/test_hierarchy $(BUILD)/tests/test_api $(BUILD)/tests/test_callbacks
+TEST_BIN := $(TEST_SLOW) $(filter-out $(TEST_SLOW),$(TEST_SRC:tests/%.c=$(BUILD)/tests/%))
 FLANN_TEST := $(BUILD)/tests/flann_kdtree
 
 SAMPLE_TOOL := $(BUILD)/tests/sample_tool
@@ -50,6 +52,8 @@ PIP     := $(PY) -m pip install -q --disable-pip-version-check
 PKG_SRC := bindings/python/pyproject.toml bindings/python/setup.py $(wildcard bindings/python/vpds/*.py) \
 	$(LIB_SRC) $(LIB_HDR)
 
+# test programs run side by side, one per core
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 VALGRIND := valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect
 
 .PHONY: all test demo deps install clean bench check-c check-flann check-py check-sanitizers check-abi \
@@ -101,7 +105,7 @@ $(UNITY_OBJ): $(LIB_SRC) $(LIB_HDR)
 check-c: $(TEST_BIN) $(UNITY_OBJ)
 	@test "$(sort $(wildcard libvpds/*.c))" = "$(sort $(LIB_SRC))" || \
 	  { echo "libvpds/sources.txt does not list exactly the files libvpds/*.c"; exit 1; }
-	@set -e; for t in $(TEST_BIN); do echo "== $$t"; $$t; done
+	@bash tools/run_tests.sh $(JOBS) $(BUILD)/logs/c $(TEST_BIN)
 
 check-flann: $(FLANN_TEST)
 	$(FLANN_TEST)
@@ -137,7 +141,7 @@ check-fuzz-fails: $(FUZZ_LIB_OBJ)
 	@bash tests/fuzz_fails.sh $(BUILD)
 
 check-valgrind: $(TEST_BIN)
-	@set -e; for t in $(TEST_BIN); do echo "== valgrind $$t"; VPDS_TEST_QUICK=1 $(VALGRIND) $$t; done
+	@VPDS_TEST_QUICK=1 bash tools/run_tests.sh $(JOBS) $(BUILD)/logs/valgrind --wrap "$(VALGRIND)" $(TEST_BIN)
 
 check-determinism:
 	bash tests/determinism.sh $(BUILD)/determinism
@@ -186,7 +190,7 @@ check-py: $(SAMPLE_TOOL) $(VENV)/.vpds-installed
 
 # The C tests again with AddressSanitizer and UndefinedBehaviorSanitizer (a separate build).
 check-sanitizers:
-	$(MAKE) --no-print-directory BUILD=$(BUILD)/san OPT=-O1 EXTRA_CFLAGS="$(SAN_FLAGS)" \
+	$(MAKE) --no-print-directory -j $(JOBS) BUILD=$(BUILD)/san OPT=-O1 EXTRA_CFLAGS="$(SAN_FLAGS)" \
 	  CC="$(CC) $(SAN_FLAGS)" check-c
 
 # A fresh machine: install the dependencies once (the stamp remembers), then every check.
@@ -199,7 +203,7 @@ $(DEPS_STAMP): tools/deps.sh tests/requirements.txt | $(PY)
 PHASE := bash tools/phase.sh
 SUBMAKE := $(MAKE) --no-print-directory
 test: $(DEPS_STAMP)
-	@$(PHASE) build $(SUBMAKE) all $(TEST_BIN) $(FLANN_TEST) $(SAMPLE_TOOL)
+	@$(PHASE) build $(SUBMAKE) -j $(JOBS) all $(TEST_BIN) $(FLANN_TEST) $(SAMPLE_TOOL)
 	@$(PHASE) c-tests $(SUBMAKE) check-c
 	@$(PHASE) abi+readme $(SUBMAKE) check-abi
 	@$(PHASE) flann $(SUBMAKE) check-flann

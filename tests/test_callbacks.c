@@ -241,7 +241,7 @@ int main(void)
     static const long periods[] = {2, 3, 7, 31, 257, 4099};
     size_t i, j, n_periods = sizeof periods / sizeof periods[0];
     quick = getenv("VPDS_TEST_QUICK") != NULL;
-    if (quick) n_periods = 3;
+    if (quick) n_periods = 2; /* a failure every 31 and 257 calls */
     for (i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         const scenario *c = &cases[i];
         snapshot ref, got;
@@ -249,7 +249,7 @@ int main(void)
         CHECK(drive(c, 0, NULL, &ref) == 0);
         CHECK_MSG(ref.n > (c->stream ? (size_t)c->stream - 1 : 50u), "%s: %zu samples", c->name, ref.n);
         for (j = 0; j < n_periods; j++) {
-            long every = periods[quick ? j + 2 : j];
+            long every = periods[quick ? j + 3 : j];
             total += drive(c, every, &ref, &got);
             CHECK_MSG(got.n == ref.n && memcmp(got.x, ref.x, ref.n * 2 * sizeof(double)) == 0 &&
                       memcmp(got.r, ref.r, ref.n * sizeof(double)) == 0 &&
