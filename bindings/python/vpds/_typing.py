@@ -1,0 +1,19 @@
+"""Type aliases of what the public functions take (annotations only: nothing here is checked)."""
+from __future__ import annotations
+
+from typing import Any, Callable, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ["BoundsLike", "DomainFunction", "RngLike", "SizingFunction"]
+
+#: one value per axis, shape (d,): a sequence or an array (read value by value)
+BoundsLike = Union[Sequence[float], npt.NDArray[Any]]
+#: a vectorised r(x): points of shape (m, d) in, (m,) radii out
+SizingFunction = Callable[[npt.NDArray[np.float64]], npt.ArrayLike]
+#: a vectorised signed distance (negative inside, 1-Lipschitz): points (m, d) in, (m,) out
+DomainFunction = Callable[[npt.NDArray[np.float64]], npt.ArrayLike]
+#: what `rng` takes (scipy's rule): numpy.random.default_rng's seeds, or a RandomState
+RngLike = Union[None, int, np.integer[Any], Sequence[int], np.random.SeedSequence,
+                np.random.BitGenerator, np.random.Generator, np.random.RandomState]
