@@ -6,7 +6,13 @@ from typing import Any, Callable, Sequence, Union
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["BoundsLike", "DomainFunction", "RngLike", "SizingFunction"]
+__all__ = ["BoolArray", "BoundsLike", "DomainFunction", "FloatArray", "IndexArray", "RngLike",
+           "SizingFunction"]
+
+# short names where arrays abound (analysis, plots): float64 values, bool masks, int64 indices
+FloatArray = npt.NDArray[np.float64]
+BoolArray = npt.NDArray[np.bool_]
+IndexArray = npt.NDArray[np.int64]
 
 #: one value per axis, shape (d,): a sequence or an array (read value by value)
 BoundsLike = Union[Sequence[float], npt.NDArray[Any]]
