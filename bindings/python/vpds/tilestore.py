@@ -119,7 +119,8 @@ class TileStore:
         """The run's insertion order of tiles: by phase, then index."""
         return sorted(range(self.count), key=lambda k: (self.phases[k], k))
 
-    def iter_tiles(self, order: str = "insertion") -> Iterator[tuple[int, npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]]:
+    def iter_tiles(self, order: str = "insertion"
+                   ) -> Iterator[tuple[int, npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]]:
         """(tile, points, radius, t) one tile at a time: memory holds one tile, whatever the
         total. order="insertion" (phase, then index: the order in which the union is
         conflict-free under any rule) or "index"."""
@@ -133,7 +134,8 @@ class TileStore:
         """Samples in the complete tiles."""
         return sum(self.tile_count(k) for k in range(self.count) if self.complete(k))
 
-    def to_numpy(self, order: str = "insertion") -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    def to_numpy(self, order: str = "insertion"
+                 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]:
         """Every sample at once (for runs that fit in memory)."""
         parts = list(self.iter_tiles(order))
         if not parts:
