@@ -406,8 +406,8 @@ class PoissonDisk:
 
     def refine(self, t: float) -> npt.NDArray[np.float64]:
         """Discrete decrease (Section 4.3): maximal at the smaller scale t; returns the new
-        samples. After an exception (Ctrl-C, a raising callable), refine(t) again continues
-        the refinement and returns all its samples, those of the stopped call included."""
+        samples, shape (m, d). After an exception (Ctrl-C, a raising callable), refine(t) again
+        continues the refinement and returns all its samples, those of the stopped call included."""
         t = float(t)
         before = int(lib.vpds_count(self._sampler("refine()")))
         st = lib.vpds_get_stats(self._s)
@@ -427,7 +427,8 @@ class PoissonDisk:
         return self.points[before:]
 
     def stream(self, t_min: float = 0.0) -> Iterator[tuple[npt.NDArray[np.float64], float]]:
-        """The continuous decrease (Section 4.2): (point, t) one at a time, t non-increasing."""
+        """The continuous decrease (Section 4.2): (point, t) one at a time, the point of shape
+        (d,), t non-increasing."""
         self._sampler("stream()")
         x = ffi.new("double[]", self.d)
         t = ffi.new("double *")
@@ -439,7 +440,8 @@ class PoissonDisk:
             yield np.frombuffer(ffi.buffer(x, self.d * 8), dtype=np.float64).copy(), float(t[0])
 
     def progressive(self, n: int, *, inhibition: Optional[float] = 0.5) -> Progressive:
-        """Exactly n points: the first n samples of the continuous stream from this sampler's
+        """Exactly n points (Progressive: points (n, d), scales (n,), t; fewer points if the set
+        becomes maximal first): the first n samples of the continuous stream from this sampler's
         fixed points (a fresh stream with the same seed; this sampler is not changed). Each
         prefix is maximal at its own scale, so any n gives an evenly spread set; `t` is the
         scale reached. `inhibition` is R_f / R_c for this stream: with 1 (equal radii) the
@@ -474,7 +476,8 @@ class PoissonDisk:
         return self.stream()
 
     def add_points(self, x: npt.ArrayLike, r: Optional[npt.ArrayLike] = None) -> None:
-        """Fixed points now (between runs): objects already placed, t = +inf."""
+        """Fixed points now (between runs): objects already placed, t = +inf; x of shape (k, d),
+        r (k,) or None (the sizing decides)."""
         self._sampler("add_points()")
         fx = np.ascontiguousarray(x, dtype=np.float64).reshape(-1, self.d)
         fr = None if r is None else np.ascontiguousarray(r, dtype=np.float64).reshape(-1)

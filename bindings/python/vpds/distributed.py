@@ -86,8 +86,9 @@ def sample(store: Union[str, Path], d: int, tiles: Union[int, Sequence[int]], *,
            address: Optional[str] = None, client: Optional[Client] = None, n_workers: Optional[int] = None,
            progress: bool = True, overwrite: bool = False,
            on_tile: Optional[Callable[[int, int], None]] = None) -> TileStore:
-    """Sample the box [l_bounds, u_bounds] as `tiles` tiles per axis into the Zarr store at
-    `store`, on Dask, and return the store (a reader that streams the tiles back).
+    """Sample the box [l_bounds, u_bounds] (each of shape (d,); default 0 and 1) as `tiles` tiles
+    per axis into the Zarr store at `store`, on Dask, and return the store (a reader that streams
+    the tiles back).
 
     The sampling arguments are PoissonDisk's (`sizing`: a float, a numpy grid in memory, a
     `GridSource` or a path to a .npy / .zarr / .exr grid read one window per tile, or a

@@ -82,7 +82,7 @@ class Domain:
         self.error: Optional[BaseException] = None
 
     def __call__(self, x: npt.ArrayLike) -> npt.NDArray[np.float64]:
-        """The signed distance at points of shape (m, d)."""
+        """The signed distance at points of shape (m, d) (or one point (d,)): shape (m,)."""
         pts = np.ascontiguousarray(np.atleast_2d(x), dtype=np.float64)
         if self.fn is not None:
             return np.asarray(self.fn(pts), dtype=np.float64).reshape(-1)
@@ -114,7 +114,8 @@ class Domain:
     @classmethod
     def mask(cls, values: npt.ArrayLike, lo: BoundsLike, hi: BoundsLike,
              threshold: float = 0.5) -> "Domain":
-        """A mask over the box [lo, hi]: inside where value >= threshold (True for booleans)."""
+        """A mask over the box [lo, hi] (each (d,)), `values` with one axis per dimension (C
+        order): inside where value >= threshold (True for booleans)."""
         v = np.asarray(values)
         if v.dtype == bool:
             v = v.astype(np.float64)

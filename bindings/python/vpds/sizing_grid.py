@@ -13,7 +13,8 @@ __all__ = ["SizingGrid"]
 
 class SizingGrid:
     """Radii at the nodes of a regular grid over [lo, hi] (C order, axis k along x[k]),
-    interpolated multilinearly. `lipschitz` is exact (the largest gradient norm)."""
+    interpolated multilinearly: `values` has one axis per dimension, lo and hi shape (d,).
+    `lipschitz` is exact (the largest gradient norm)."""
 
     def __init__(self, values: npt.ArrayLike, lo: BoundsLike, hi: BoundsLike) -> None:
         v = np.ascontiguousarray(values, dtype=np.float64)
@@ -38,6 +39,7 @@ class SizingGrid:
 
     @property
     def values(self) -> npt.NDArray[np.float64]:
+        """The radii at the nodes (as enforce_lipschitz left them), of the grid's shape."""
         n = lib.vpds_grid_size(self._ptr)
         buf = ffi.buffer(lib.vpds_grid_values(self._ptr), n * 8)
         v: npt.NDArray[np.float64] = np.frombuffer(buf, dtype=np.float64).reshape(self._values.shape).copy()
@@ -52,6 +54,7 @@ class SizingGrid:
         return self
 
     def __call__(self, x: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """r at points of shape (m, d) (or one point (d,)): shape (m,)."""
         pts = np.ascontiguousarray(np.atleast_2d(x), dtype=np.float64)
         return np.array([lib.vpds_grid_eval(self._ptr, ffi.cast("const double *", ffi.from_buffer(p)))
                          for p in pts])

@@ -106,7 +106,7 @@ class TileStore:
         return g["points"][...], g["radius"][...], g["t"][...]
 
     def read_points(self, tile: int) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-        """(points, radius) of a complete tile: what a dependent tile's run needs."""
+        """(points (n, d), radius (n,)) of a complete tile: what a dependent tile's run needs."""
         if not self.complete(tile):
             raise KeyError(f"tile {tile} of {self.path} is not complete")
         return self._node(f"tiles/{int(tile)}/points")[...], self._node(f"tiles/{int(tile)}/radius")[...]
@@ -121,9 +121,9 @@ class TileStore:
 
     def iter_tiles(self, order: str = "insertion"
                    ) -> Iterator[tuple[int, npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]]:
-        """(tile, points, radius, t) one tile at a time: memory holds one tile, whatever the
-        total. order="insertion" (phase, then index: the order in which the union is
-        conflict-free under any rule) or "index"."""
+        """(tile, points (n, d), radius (n,), t (n,)) one tile at a time: memory holds one tile,
+        whatever the total. order="insertion" (phase, then index: the order in which the union
+        is conflict-free under any rule) or "index"."""
         tiles = self.order() if order == "insertion" else range(self.count)
         for k in tiles:
             x, r, t = self.read(k)
@@ -136,7 +136,8 @@ class TileStore:
 
     def to_numpy(self, order: str = "insertion"
                  ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-        """Every sample at once (for runs that fit in memory)."""
+        """Every sample at once, (points (n, d), radius (n,), t (n,)) (for runs that fit in
+        memory)."""
         parts = list(self.iter_tiles(order))
         if not parts:
             return np.empty((0, self.d)), np.empty(0), np.empty(0)

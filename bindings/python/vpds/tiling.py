@@ -217,6 +217,7 @@ class Tiling:
         return int(lib.vpds_tiling_seed(self._t, self._check_tile(tile)))
 
     def box(self, tile: int) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """(lo, hi) of the tile's core, each of shape (d,)."""
         lo = ffi.new("double[]", self.spec.d)
         hi = ffi.new("double[]", self.spec.d)
         lib.vpds_tiling_box(self._t, self._check_tile(tile), lo, hi)
