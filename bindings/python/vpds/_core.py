@@ -53,7 +53,7 @@ class Progressive(NamedTuple):
     at its own scale, so the n points are evenly spread at scale `t`."""
     points: npt.NDArray[np.float64]  # (n, d)
     scales: npt.NDArray[np.float64]  # (n,): the t of each sample, non-increasing (inf for the first)
-    t: float            # the scale reached: the set is maximal at t (the last sample's t)
+    t: float                         # the scale reached: the set is maximal at t (the last sample's t)
 
 
 class PoissonDisk:

@@ -46,7 +46,8 @@ def estimate_radius(n: int, d: int, volume: float = 1.0) -> float:
     if not volume > 0 or not math.isfinite(volume):
         raise ValueError(f"volume = {volume}: must be finite and > 0")
     unit_ball = math.pi ** (d / 2) / math.gamma(d / 2 + 1)
-    r: float = 2.0 * (JAMMING_DENSITY[d] * volume / (n * unit_ball)) ** (1.0 / d)  # ** of floats is Any to mypy
+    # annotated: float ** float is Any to mypy (a negative base would give a complex)
+    r: float = 2.0 * (JAMMING_DENSITY[d] * volume / (n * unit_ball)) ** (1.0 / d)
     return r
 
 
