@@ -57,7 +57,7 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 VALGRIND := valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect
 
 .PHONY: all test demo deps install clean bench check-c check-flann check-py check-sanitizers check-abi \
-	check-valgrind check-determinism check-fuzz check-fuzz-fails fuzz amalgamate check-consumers wheel check-wheel
+	check-valgrind check-determinism check-fuzz check-fuzz-fails fuzz amalgamate check-consumers wheel check-wheel check-types
 all: $(SHARED) $(STATIC) $(BUILD)/vpds.pc
 
 $(BUILD)/obj/%.o: libvpds/%.c $(LIB_HDR)
@@ -183,6 +183,10 @@ wheel: | $(PY)
 check-wheel: wheel
 	bash tests/wheel_check.sh $(WHEEL_DIR) $(VERSION)
 
+# mypy --strict on the package (its configuration: bindings/python/pyproject.toml)
+check-types: $(DEPS_STAMP)
+	$(PY) -m mypy --config-file bindings/python/pyproject.toml bindings/python/vpds
+
 # pytest-xdist: one worker per core (PYTEST_WORKERS=0 for one process)
 PYTEST_WORKERS ?= auto
 check-py: $(SAMPLE_TOOL) $(VENV)/.vpds-installed
@@ -213,6 +217,7 @@ test: $(DEPS_STAMP)
 	@$(PHASE) valgrind $(SUBMAKE) check-valgrind
 	@$(PHASE) determinism $(SUBMAKE) check-determinism
 	@$(PHASE) fuzz $(SUBMAKE) check-fuzz
+	@$(PHASE) types $(SUBMAKE) check-types
 	@$(PHASE) python $(SUBMAKE) check-py
 	@echo "all tests passed (logs in build/logs)"
 

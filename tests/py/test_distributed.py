@@ -283,3 +283,14 @@ def test_cli_tiles(tmp_path, cluster, capsys):
                          text=True)
     assert res.returncode == 0 and "all guarantees hold" in res.stdout, res.stdout + res.stderr
     assert "run: tiles" in res.stdout and "radius 0.03" in res.stdout
+
+
+def test_sizing_file_with_array_bounds(tmp_path):
+    """A sizing given as a file path with the bounds as numpy arrays (which have no truth value)
+    samples the box those bounds give."""
+    np.save(tmp_path / "g.npy", np.full((9, 7), 0.05))
+    store = D.sample(tmp_path / "a.zarr", 2, 2, sizing=str(tmp_path / "g.npy"),
+                     l_bounds=np.array([0.0, 0.0]), u_bounds=np.array([2.0, 1.0]), rng=3,
+                     n_workers=1, progress=False)
+    x = store.to_numpy()[0]
+    assert len(x) > 100 and x[:, 0].max() > 1.5 and x[:, 0].max() <= 2.0

@@ -4,8 +4,9 @@
     >>> engine = vpds.PoissonDisk(2, radius=0.05, rng=1)
     >>> x = engine.fill_space()          # maximal, shape (n, 2)
 """
-from ._core import (ALGORITHM_VERSION, RULES, PoissonDisk, Progressive, SizingGrid, VpdsDomainError, VpdsError,
-                    VpdsSizingError, VpdsStateError, VpdsUnsupportedError, VpdsValueError)
+from ._core import ALGORITHM_VERSION, RULES, PoissonDisk, Progressive, SizingGrid
+from ._errors import (VpdsDomainError, VpdsError, VpdsSizingError, VpdsStateError, VpdsUnsupportedError,
+                      VpdsValueError)
 from .domain import Domain, estimate_radius
 from ._vpds import ffi as _ffi, lib as _lib
 

@@ -27,6 +27,7 @@ from types import TracebackType
 from typing import Any, Callable, NoReturn, Optional
 
 import numpy as np
+import numpy.typing as npt
 
 from ._errors import _raise
 from ._vpds import ffi, lib
@@ -38,7 +39,7 @@ class CallbackResultError(ValueError):
     """A callable returned something the library cannot use (found by the binding)."""
 
 
-def as_values(out: Any, n: int, what: str, flat: bool = False) -> np.ndarray:
+def as_values(out: Any, n: int, what: str, flat: bool = False) -> npt.NDArray[np.float64]:
     """A callable's result as n float64 values (flat: of any shape holding n values), else a
     CallbackResultError saying why."""
     try:
@@ -67,12 +68,12 @@ def keep(user: Any, slot: str, exc: BaseException) -> bool:
     return True
 
 
-def escaped(slot: str) -> Callable[[type, BaseException, Optional[TracebackType]], None]:
+def escaped(slot: str) -> Callable[[type[BaseException], BaseException, Optional[TracebackType]], None]:
     """The cffi onerror handler of a callback whose argument `user` is the handle of an owner
     keeping exceptions in attribute `slot`: keep the escaped exception there. cffi then returns
     the callback's `error` value, and prints nothing."""
 
-    def onerror(exc_type: type, exc: BaseException, tb: Optional[TracebackType]) -> None:
+    def onerror(exc_type: type[BaseException], exc: BaseException, tb: Optional[TracebackType]) -> None:
         while tb is not None:  # the callback's frame is the first (it was called from C)
             user = tb.tb_frame.f_locals.get("user")
             if user is not None and keep(user, slot, exc):

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import os
-from typing import Any, Callable, Iterator, NamedTuple, Optional, Sequence, Union
+from typing import Any, Callable, Iterator, NamedTuple, Optional, Sequence, SupportsFloat, Union, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -11,9 +11,10 @@ from ._callbacks import as_values, escaped, keep, raise_failure, take
 from ._errors import (VpdsDomainError, VpdsError, VpdsSizingError, VpdsStateError,
                       VpdsUnsupportedError, VpdsValueError, _raise, created)
 from ._vpds import ffi, lib
-from .domain import Domain, as_domain
+from .domain import Domain, DomainLike, as_domain
 from ._scipy_compat import _optimization_name, _scipy_optimizers, _seed_from, _validate_bounds
 from .sizing_grid import SizingGrid
+from ._typing import RngLike, SizingFunction
 
 __all__ = ["PoissonDisk", "SizingGrid", "VpdsError", "VpdsSizingError", "VpdsDomainError",
            "Progressive", "RULES", "ALGORITHM_VERSION"]
@@ -25,10 +26,12 @@ RULES = {"prior": lib.VPDS_RULE_PRIOR, "current": lib.VPDS_RULE_CURRENT,
 # work units (darts + cells) per C call in a fill: small enough for a responsive Ctrl-C and
 # progress bar, large enough that the calls cost nothing measurable
 _CHUNK = 50_000
+#: what `sizing` takes: a radius, a grid of radii (d axes), a SizingGrid, r(x), an EXR image path
+SizingLike = Union[None, float, npt.ArrayLike, SizingGrid, SizingFunction, str, os.PathLike[str]]
 
 
 @ffi.def_extern(error=1, onerror=escaped("_callback_error"))
-def vpds_py_sizing_batch(x, n, r_out, user):  # type: ignore[no-untyped-def]
+def vpds_py_sizing_batch(x: Any, n: int, r_out: Any, user: Any) -> int:
     """Called by the C library with n points: one vectorised call of the Python sizing. An
     exception is kept in the owner's _callback_error (re-raised after the C call) and fails
     the batch; after one, every call fails at once until the binding has taken it."""
@@ -48,9 +51,9 @@ def vpds_py_sizing_batch(x, n, r_out, user):  # type: ignore[no-untyped-def]
 class Progressive(NamedTuple):
     """The first n samples of the continuous stream: each prefix is conflict-free and maximal
     at its own scale, so the n points are evenly spread at scale `t`."""
-    points: np.ndarray  # (n, d)
-    scales: np.ndarray  # (n,): the t of each sample, non-increasing (inf for the first)
-    t: float            # the scale reached: the set is maximal at t (the last sample's t)
+    points: npt.NDArray[np.float64]  # (n, d)
+    scales: npt.NDArray[np.float64]  # (n,): the t of each sample, non-increasing (inf for the first)
+    t: float                         # the scale reached: the set is maximal at t (the last sample's t)
 
 
 class PoissonDisk:
@@ -114,19 +117,19 @@ class PoissonDisk:
     """
 
     def __init__(self, d: int, *, radius: float = 0.05, hypersphere: str = "volume",
-                 ncandidates: int = 30, optimization: Optional[str] = None, rng: Any = None,
+                 ncandidates: int = 30, optimization: Optional[str] = None, rng: RngLike = None,
                  l_bounds: Optional[npt.ArrayLike] = None, u_bounds: Optional[npt.ArrayLike] = None,
-                 sizing: Union[None, float, npt.ArrayLike, SizingGrid, Callable[[np.ndarray], np.ndarray]] = None,
+                 sizing: SizingLike = None,
                  lipschitz: Optional[float] = None, enforce_lipschitz: Optional[float] = None,
                  rule: str = "smaller", inhibition: float = 1.0, coverage: float = 1.0,
                  periodic: Optional[Sequence[bool]] = None, weighted: bool = False,
                  radius_min: Optional[float] = None, radius_max: Optional[float] = None,
                  fixed_points: Optional[npt.ArrayLike] = None,
                  fixed_radii: Optional[npt.ArrayLike] = None, progress: bool = True,
-                 seed: Any = None, sizing_channel: Optional[str] = None,
+                 seed: RngLike = None, sizing_channel: Optional[str] = None,
                  sizing_range: Optional[Sequence[float]] = None,
-                 sizing_grid_shape: Optional[Sequence[int]] = None, domain: Any = None,
-                 domain_threshold: float = 0.5, algorithm_version: Optional[int] = None):
+                 sizing_grid_shape: Optional[Sequence[int]] = None, domain: Optional[DomainLike] = None,
+                 domain_threshold: float = 0.5, algorithm_version: Optional[int] = None) -> None:
         if seed is not None and rng is not None:
             raise TypeError("PoissonDisk() got multiple values for argument now known as `rng`. "
                             "Specify one of `rng` or `seed`.")
@@ -161,9 +164,9 @@ class PoissonDisk:
         self.progress = progress
         self._seed = _seed_from(seed if seed is not None else rng)
         self._callback_error: Optional[BaseException] = None
-        self._sizing_fn: Optional[Callable[[np.ndarray], np.ndarray]] = None
+        self._sizing_fn: Optional[SizingFunction] = None
         self._grid: Optional[SizingGrid] = None
-        self._keep: list = []  # C memory the descriptor points to
+        self._keep: list[Any] = []  # C memory the descriptor points to
 
         desc = ffi.new("vpds_desc *", lib.vpds_default_desc())
         desc.dim = self.d
@@ -193,8 +196,9 @@ class PoissonDisk:
             sizing = SizingGrid(values, self.l_bounds, self.u_bounds)
             lipschitz = None  # the grid's own, exact L replaces the callable's
         if sizing is not None and not callable(sizing) and np.ndim(sizing) == 0:
-            desc.radius = float(sizing)
-            self.radius = float(sizing)
+            # np.ndim 0: a number or a 0-d array, both of which float() takes
+            desc.radius = float(cast(SupportsFloat, sizing))
+            self.radius = float(cast(SupportsFloat, sizing))
         elif isinstance(sizing, SizingGrid) or (sizing is not None and not callable(sizing)):
             grid = sizing if isinstance(sizing, SizingGrid) else SizingGrid(sizing, self.l_bounds, self.u_bounds)
             if enforce_lipschitz is not None:
@@ -263,7 +267,7 @@ class PoissonDisk:
                              "scipy's random(n) of shape (n, 0), fill_space() and reset())")
         return self._s
 
-    def _optimized(self, sample: np.ndarray) -> np.ndarray:
+    def _optimized(self, sample: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         """`sample` through scipy's optimizer (as its QMCEngine.random does), in the box mapped
         onto the unit cube where scipy's optimizers work; unchanged without optimization."""
         if self.optimization is None or len(sample) == 0:
@@ -337,7 +341,7 @@ class PoissonDisk:
             if bar is not None:
                 bar.close()
 
-    def _draw(self, n: Union[int, float]) -> np.ndarray:
+    def _draw(self, n: Union[int, float]) -> npt.NDArray[np.float64]:
         """The next n samples as drawn (fewer if the set becomes maximal first)."""
         if isinstance(n, (float, np.floating)) and not float(n).is_integer():
             raise ValueError(f"n = {n!r}: must be an integer number of samples (or inf)")
@@ -354,7 +358,7 @@ class PoissonDisk:
         self.num_generated += len(out)
         return out
 
-    def random(self, n: Union[int, float] = 1, *, workers: int = 1) -> np.ndarray:
+    def random(self, n: Union[int, float] = 1, *, workers: int = 1) -> npt.NDArray[np.float64]:
         """The next n samples of the bias-free process (fewer if the set becomes maximal
         first, as scipy does), shape (n, d), through the `optimization` if one is set.
         n = inf is fill_space() (scipy's fill_space is random(inf)). `workers` is accepted
@@ -363,7 +367,7 @@ class PoissonDisk:
             return self.fill_space()
         return self._optimized(self._draw(n))
 
-    def fill_space(self) -> np.ndarray:
+    def fill_space(self) -> npt.NDArray[np.float64]:
         """Every remaining sample until the set is maximal (all of them, as scipy's
         fill_space returns the samples it adds), shape (m, d), through the `optimization` if
         one is set. With d = 0 there is nothing to fill: shape (0, 0)."""
@@ -382,7 +386,7 @@ class PoissonDisk:
         return self
 
     def integers(self, l_bounds: npt.ArrayLike, *, u_bounds: Optional[npt.ArrayLike] = None,
-                 n: int = 1, endpoint: bool = False, workers: int = 1) -> np.ndarray:
+                 n: int = 1, endpoint: bool = False, workers: int = 1) -> npt.NDArray[np.int64]:
         """scipy's QMCEngine.integers: random(n) mapped from the box onto integers in
         [l_bounds, u_bounds) ([l_bounds, u_bounds] with endpoint; l_bounds 0 when u_bounds is
         None) by floor of the affine map, shape (n, d), int64. A sample on the box's upper
@@ -400,10 +404,10 @@ class PoissonDisk:
         unit = (sample - self.l_bounds) / (self.u_bounds - self.l_bounds)
         return np.minimum(np.floor(unit * (upper - lower) + lower), upper - 1).astype(np.int64)
 
-    def refine(self, t: float) -> np.ndarray:
+    def refine(self, t: float) -> npt.NDArray[np.float64]:
         """Discrete decrease (Section 4.3): maximal at the smaller scale t; returns the new
-        samples. After an exception (Ctrl-C, a raising callable), refine(t) again continues
-        the refinement and returns all its samples, those of the stopped call included."""
+        samples, shape (m, d). After an exception (Ctrl-C, a raising callable), refine(t) again
+        continues the refinement and returns all its samples, those of the stopped call included."""
         t = float(t)
         before = int(lib.vpds_count(self._sampler("refine()")))
         st = lib.vpds_get_stats(self._s)
@@ -415,15 +419,16 @@ class PoissonDisk:
         def step() -> int:
             if first[0]:
                 first[0] = False
-                return lib.vpds_refine(self._s, t)
-            return lib.vpds_run(self._s)
+                return int(lib.vpds_refine(self._s, t))
+            return int(lib.vpds_run(self._s))
         self._run_until(step, None, f"refining to t={t}")
         self._refining = None
         self.num_generated = int(lib.vpds_count(self._s))
         return self.points[before:]
 
-    def stream(self, t_min: float = 0.0) -> Iterator[tuple[np.ndarray, float]]:
-        """The continuous decrease (Section 4.2): (point, t) one at a time, t non-increasing."""
+    def stream(self, t_min: float = 0.0) -> Iterator[tuple[npt.NDArray[np.float64], float]]:
+        """The continuous decrease (Section 4.2): (point, t) one at a time, the point of shape
+        (d,), t non-increasing."""
         self._sampler("stream()")
         x = ffi.new("double[]", self.d)
         t = ffi.new("double *")
@@ -435,7 +440,8 @@ class PoissonDisk:
             yield np.frombuffer(ffi.buffer(x, self.d * 8), dtype=np.float64).copy(), float(t[0])
 
     def progressive(self, n: int, *, inhibition: Optional[float] = 0.5) -> Progressive:
-        """Exactly n points: the first n samples of the continuous stream from this sampler's
+        """Exactly n points (Progressive: points (n, d), scales (n,), t; fewer points if the set
+        becomes maximal first): the first n samples of the continuous stream from this sampler's
         fixed points (a fresh stream with the same seed; this sampler is not changed). Each
         prefix is maximal at its own scale, so any n gives an evenly spread set; `t` is the
         scale reached. `inhibition` is R_f / R_c for this stream: with 1 (equal radii) the
@@ -466,11 +472,12 @@ class PoissonDisk:
                                dtype=np.float64)[first:].copy()
         return Progressive(pts, scales, float(scales[-1]) if len(scales) else float("inf"))
 
-    def __iter__(self) -> Iterator[tuple[np.ndarray, float]]:
+    def __iter__(self) -> Iterator[tuple[npt.NDArray[np.float64], float]]:
         return self.stream()
 
     def add_points(self, x: npt.ArrayLike, r: Optional[npt.ArrayLike] = None) -> None:
-        """Fixed points now (between runs): objects already placed, t = +inf."""
+        """Fixed points now (between runs): objects already placed, t = +inf; x of shape (k, d),
+        r (k,) or None (the sizing decides)."""
         self._sampler("add_points()")
         fx = np.ascontiguousarray(x, dtype=np.float64).reshape(-1, self.d)
         fr = None if r is None else np.ascontiguousarray(r, dtype=np.float64).reshape(-1)
@@ -487,36 +494,37 @@ class PoissonDisk:
         return 0 if self._s is None else int(lib.vpds_count(self._s))
 
     @property
-    def points(self) -> np.ndarray:
+    def points(self) -> npt.NDArray[np.float64]:
         """All samples so far, insertion order, shape (n, d) (as drawn: before any
         `optimization`)."""
         n = self._count()
         if n == 0:
             return np.empty((0, self.d))
-        return np.frombuffer(ffi.buffer(lib.vpds_points(self._s), n * self.d * 8),
-                             dtype=np.float64).reshape(n, self.d).copy()
+        x: npt.NDArray[np.float64] = np.frombuffer(ffi.buffer(lib.vpds_points(self._s), n * self.d * 8),
+                                                   dtype=np.float64).reshape(n, self.d).copy()
+        return x
 
     @property
-    def radii(self) -> np.ndarray:
+    def radii(self) -> npt.NDArray[np.float64]:
         """r at each sample (unscaled), shape (n,)."""
         n = self._count()
         return np.frombuffer(ffi.buffer(lib.vpds_radii(self._s), n * 8), dtype=np.float64).copy() if n else np.empty(0)
 
     @property
-    def scales(self) -> np.ndarray:
+    def scales(self) -> npt.NDArray[np.float64]:
         """The scale t at which each sample was inserted (inf for fixed points), shape (n,)."""
         n = self._count()
         return np.frombuffer(ffi.buffer(lib.vpds_scales(self._s), n * 8), dtype=np.float64).copy() if n else np.empty(0)
 
     @property
-    def fixed(self) -> np.ndarray:
+    def fixed(self) -> npt.NDArray[np.bool_]:
         """True where the sample is a fixed point, shape (n,)."""
         n = self._count()
         flags = np.frombuffer(ffi.buffer(lib.vpds_flags(self._s), n), dtype=np.uint8) if n else np.empty(0, np.uint8)
         return (flags & 1).astype(bool)
 
     @property
-    def stats(self) -> dict:
+    def stats(self) -> dict[str, Union[int, float]]:
         st = lib.vpds_get_stats(self._sampler("stats"))
         return {k: getattr(st, k) for k in ("darts", "accepted", "levels", "peak_active_cells",
                                              "bytes_held", "peak_bytes", "sizing_calls", "delta",

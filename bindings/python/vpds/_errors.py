@@ -1,7 +1,7 @@
 """Errors of libvpds as Python exceptions, and the validate-then-create of its C objects."""
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import Any, NoReturn, Optional
 
 from ._vpds import ffi, lib
 
@@ -12,7 +12,7 @@ __all__ = ["VpdsError", "VpdsValueError", "VpdsSizingError", "VpdsUnsupportedErr
 class VpdsError(RuntimeError):
     """An error status from libvpds, with the library's message (argument, value, why)."""
 
-    def __init__(self, status: int, message: str):
+    def __init__(self, status: int, message: str) -> None:
         self.status = status
         name = ffi.string(lib.vpds_status_string(status)).decode().split(":")[0]
         super().__init__(f"{name}: {message}")
@@ -38,7 +38,7 @@ class VpdsStateError(VpdsError):
     """The call is not valid in the sampler's current state (e.g. refining to a larger t)."""
 
 
-def _raise(status: int, message: str, cause: Optional[BaseException] = None) -> None:
+def _raise(status: int, message: str, cause: Optional[BaseException] = None) -> NoReturn:
     if status == lib.VPDS_ERR_OUT_OF_MEMORY:
         raise MemoryError(message)
     cls = {lib.VPDS_ERR_INVALID_ARGUMENT: VpdsValueError, lib.VPDS_ERR_OVERFLOW: VpdsValueError,

@@ -8,12 +8,13 @@ import numpy as np
 import numpy.typing as npt
 
 from ._optional import MissingDependencyError, require
+from ._typing import RngLike
 
 _SEED_LIMIT = 2**64  # ints below are the C seed itself
 _OPTIMIZATIONS = "{'random-cd', 'lloyd'}"
 
 
-def _seed_from(rng: Any) -> int:
+def _seed_from(rng: RngLike) -> int:
     """The C seed of an `rng` (scipy's rule, numpy.random.default_rng, with one exception kept
     for the C library's sake):
 
@@ -51,10 +52,10 @@ def _seed_from(rng: Any) -> int:
 
 
 def _validate_bounds(l_bounds: Optional[npt.ArrayLike], u_bounds: Optional[npt.ArrayLike],
-                     d: int) -> tuple[np.ndarray, np.ndarray]:
+                     d: int) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
     """scipy.stats.qmc's rule for bounds (its _validate_bounds, its messages): each broadcast
     to (d,) (default 0 and 1), l_bounds < u_bounds on every axis; float64 copies."""
-    def values(name: str, v: Optional[npt.ArrayLike], default: float) -> np.ndarray:
+    def values(name: str, v: Optional[npt.ArrayLike], default: float) -> npt.NDArray[np.float64]:
         if v is None:
             return np.full(d, default)
         try:
@@ -97,9 +98,9 @@ def _scipy_optimizers(optimization: str) -> Callable[..., Any]:
     """scipy.stats.qmc's factory of optimizers (what its QMCEngine calls), imported here."""
     impl = require("scipy.stats._qmc", f"optimization = {optimization!r} (scipy.stats.qmc's "
                    "optimizers)", "scipy")
-    select = getattr(impl, "_select_optimizer", None)
+    select: Optional[Callable[..., Any]] = getattr(impl, "_select_optimizer", None)
     if select is None:
         raise MissingDependencyError(f"optimization = {optimization!r} needs scipy >= 1.10 "
                                      "(pip install 'scipy>=1.10'): this scipy has no "
                                      "scipy.stats._qmc._select_optimizer")
-    return select  # type: ignore[no-any-return]
+    return select

@@ -16,20 +16,26 @@ so it is an independent check of its output (the project's tests use it, and `vp
     conflict-free and maximal at tau,
   - for a uniform radius, the exact largest empty ball of the box (Delaunay circumcentres),
     which is what farthest-point insertion must pick.
+
+Shapes throughout: samples x (n, d) with radii r and scales t (n,) in insertion order, the box's
+corners lo and hi (d,), points where r or g is evaluated (m, d) and their values (m,).
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Callable, Optional, Sequence
+from typing import Callable, Optional, Sequence, Union, cast
 
 import numpy as np
 from scipy.spatial import Delaunay, cKDTree
 
+from ._typing import BoolArray, FloatArray, IndexArray
+
 RULES = ("prior", "current", "bigger", "smaller")
 
 
-def rule_f(rule: str, rx: np.ndarray, ry: np.ndarray) -> np.ndarray:
+def rule_f(rule: str, rx: FloatArray, ry: FloatArray) -> FloatArray:
+    """f(x, y) of Table 1's rule from r at the earlier sample x (rx) and at y (ry), broadcast."""
     if rule == "prior":
         return np.broadcast_to(rx, np.broadcast(rx, ry).shape)
     if rule == "current":
@@ -43,7 +49,7 @@ def rule_f(rule: str, rx: np.ndarray, ry: np.ndarray) -> np.ndarray:
 class Sizing:
     """r(x) for arrays of points (m, d), with its Lipschitz constant."""
 
-    fn: Callable[[np.ndarray], np.ndarray]
+    fn: Callable[[FloatArray], FloatArray]
     lipschitz: float
 
 
@@ -55,14 +61,17 @@ def sizing_named(name: str, radius: float = 0.0) -> Sizing:
     if name == "mild":  # a gentle ramp, for the weighted process
         return Sizing(lambda y: 0.04 + 0.04 * y[:, 0], 0.04)
     if name == "radial":  # the paper's Figure 10
-        def radial(y: np.ndarray) -> np.ndarray:
+        def radial(y: FloatArray) -> FloatArray:
             d = np.sqrt(((y - 0.5) ** 2).sum(axis=1))
-            return 0.015 + (0.00015 - 0.015) * np.abs(np.sin(8 * np.pi * d))
+            r: FloatArray = 0.015 + (0.00015 - 0.015) * np.abs(np.sin(8 * np.pi * d))
+            return r
         return Sizing(radial, 0.01485 * 8 * np.pi)
     raise ValueError(name)
 
 
-def load(path: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def load(path: str) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """(x (n, d), r (n,), t (n,)) from the file tests/tools/sample_tool writes: n and d (int64),
+    then x, r and t (float64)."""
     raw = np.fromfile(path, dtype=np.int64, count=2)
     n, d = int(raw[0]), int(raw[1])
     data = np.fromfile(path, dtype=np.float64, offset=16)
@@ -72,10 +81,11 @@ def load(path: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return x, r, t
 
 
-Periodic = Optional[Sequence[bool]]
+#: one flag per axis, (d,): a sequence, or a bool array (the masks below); None: no periodic axis
+Periodic = Optional[Union[Sequence[bool], BoolArray]]
 
 
-def _periodic_mask(periodic: Periodic, d: int) -> Optional[np.ndarray]:
+def _periodic_mask(periodic: Periodic, d: int) -> Optional[BoolArray]:
     """The periodic flags as a bool array, or None when no axis is periodic."""
     if periodic is None:
         return None
@@ -85,7 +95,7 @@ def _periodic_mask(periodic: Periodic, d: int) -> Optional[np.ndarray]:
     return m if m.any() else None
 
 
-def wrap_points(x: np.ndarray, lo: np.ndarray, hi: np.ndarray, periodic: Periodic) -> np.ndarray:
+def wrap_points(x: FloatArray, lo: FloatArray, hi: FloatArray, periodic: Periodic) -> FloatArray:
     """Points moved into [lo, hi) along the periodic axes: one representative per torus point,
     so that the 3^p images below hold the minimum image of every pair."""
     x = np.array(x, dtype=np.float64, copy=True)
@@ -98,8 +108,8 @@ def wrap_points(x: np.ndarray, lo: np.ndarray, hi: np.ndarray, periodic: Periodi
     return x
 
 
-def toroidal_distance(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                      periodic: Periodic) -> np.ndarray:
+def toroidal_distance(a: FloatArray, b: FloatArray, lo: FloatArray, hi: FloatArray,
+                      periodic: Periodic) -> FloatArray:
     """|a - b| with the minimum image along the periodic axes (rows broadcast)."""
     a, b = np.atleast_2d(a).astype(np.float64), np.atleast_2d(b).astype(np.float64)
     diff = np.abs(a - b)
@@ -108,12 +118,13 @@ def toroidal_distance(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarr
         ext = (np.asarray(hi, dtype=np.float64) - np.asarray(lo, dtype=np.float64))[mask]
         dm = np.mod(diff[:, mask], ext)
         diff[:, mask] = np.minimum(dm, ext - dm)
-    return np.sqrt((diff ** 2).sum(axis=1))
+    dist: FloatArray = np.sqrt((diff ** 2).sum(axis=1))
+    return dist
 
 
-def periodic_images(x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+def periodic_images(x: FloatArray, r: FloatArray, lo: FloatArray, hi: FloatArray,
                     periodic: Periodic, margin: Optional[float] = None
-                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                    ) -> tuple[FloatArray, FloatArray, IndexArray]:
     """(points, radii, source index) of the 3^p copies of the wrapped points shifted by -1, 0, +1
     periods along the p periodic axes, the unshifted copy first (rows 0..n-1 are the wrapped
     samples themselves). Why: for points of the box the minimum image of any sample is among
@@ -148,24 +159,24 @@ def periodic_images(x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np.ndarray
     return np.concatenate(pts), np.concatenate(rad), np.concatenate(src)
 
 
-def _wrapped_sizing(sizing: "Sizing", lo: np.ndarray, hi: np.ndarray, mask: np.ndarray) -> "Sizing":
+def _wrapped_sizing(sizing: "Sizing", lo: FloatArray, hi: FloatArray, mask: BoolArray) -> "Sizing":
     """The sizing read at the wrapped point: r of a periodic image is r of the sample."""
     return Sizing(lambda y: sizing.fn(wrap_points(y, lo, hi, mask)), sizing.lipschitz)
 
 
-def empty_disk_violations(x: np.ndarray, r: np.ndarray, rule: str, scale: float, lipschitz: float,
+def empty_disk_violations(x: FloatArray, r: FloatArray, rule: str, scale: float, lipschitz: float,
                           rel_tol: float = 1e-12, *, periodic: Periodic = None,
-                          lo: Optional[np.ndarray] = None, hi: Optional[np.ndarray] = None) -> int:
+                          lo: Optional[FloatArray] = None, hi: Optional[FloatArray] = None) -> int:
     """Pairs j < i with |x_i - x_j| < scale f(x_j, x_i) (x_j the earlier sample); with
     `periodic` (and the box lo, hi) the distance is the toroidal one."""
     scales = np.full(len(x), float(scale))
     return len(_conflict_pairs(x, r, scales, rule, lipschitz, rel_tol, periodic, lo, hi)[0])
 
 
-def conflicts_at_insertion_scales(x: np.ndarray, r: np.ndarray, t: np.ndarray, rule: str,
+def conflicts_at_insertion_scales(x: FloatArray, r: FloatArray, t: FloatArray, rule: str,
                                   inhibition: float, lipschitz: float, rel_tol: float = 0.0, *,
-                                  periodic: Periodic = None, lo: Optional[np.ndarray] = None,
-                                  hi: Optional[np.ndarray] = None) -> int:
+                                  periodic: Periodic = None, lo: Optional[FloatArray] = None,
+                                  hi: Optional[FloatArray] = None) -> int:
     """Pairs j < i with |x_i - x_j| < t_i inhibition (1 - rel_tol) f(x_j, x_i).
 
     Why: a pair j < i belongs to every prefix {k : t_k >= tau} with tau <= t_i (t non-increasing),
@@ -177,9 +188,9 @@ def conflicts_at_insertion_scales(x: np.ndarray, r: np.ndarray, t: np.ndarray, r
     return len(_conflict_pairs(x, r, scales, rule, lipschitz, 1e-12, periodic, lo, hi)[0])
 
 
-def _conflict_pairs(x: np.ndarray, r: np.ndarray, scales: np.ndarray, rule: str, lipschitz: float,
-                    rel_tol: float, periodic: Periodic, lo: Optional[np.ndarray],
-                    hi: Optional[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+def _conflict_pairs(x: FloatArray, r: FloatArray, scales: FloatArray, rule: str, lipschitz: float,
+                    rel_tol: float, periodic: Periodic, lo: Optional[FloatArray],
+                    hi: Optional[FloatArray]) -> tuple[IndexArray, IndexArray]:
     """(i, j), j < i, with |x_i - x_j| < scales[i] f(x_j, x_i) (1 - rel_tol), each pair once.
 
     Samples are processed in blocks of doubling size, each against a tree of the samples (or
@@ -200,6 +211,7 @@ def _conflict_pairs(x: np.ndarray, r: np.ndarray, scales: np.ndarray, rule: str,
     # bigger), within s r_i (current, smaller), and always within s r_max and the set's diameter
     ext = x.max(axis=0) - x.min(axis=0)
     if mask is not None:
+        assert lo is not None and hi is not None  # given with the mask (checked above)
         ext = np.maximum(ext, hi - lo)
     diam = float(np.linalg.norm(ext)) * (1 + 1e-9) + 1e-300
     sl = scales * lipschitz
@@ -216,6 +228,7 @@ def _conflict_pairs(x: np.ndarray, r: np.ndarray, scales: np.ndarray, rule: str,
         if mask is None:
             pts, src = x[:b], np.arange(b)
         else:
+            assert lo is not None and hi is not None  # given with the mask (checked above)
             pts, _, src = periodic_images(x[:b], r[:b], lo, hi, mask,
                                           margin=float(reach[a:b].max()))
         tree = cKDTree(pts)
@@ -239,14 +252,14 @@ def _conflict_pairs(x: np.ndarray, r: np.ndarray, scales: np.ndarray, rule: str,
     return i, j
 
 
-def coverage_margin(points: np.ndarray, tree: cKDTree, x: np.ndarray, r: np.ndarray, rule: str,
-                    scale: float, r_at: np.ndarray, k: int = 24, exact: bool = False) -> np.ndarray:
+def coverage_margin(points: FloatArray, tree: cKDTree, x: FloatArray, r: FloatArray, rule: str,
+                    scale: float, r_at: FloatArray, k: int = 24, exact: bool = False) -> FloatArray:
     """g at points: an upper bound from the k nearest samples, or exact (all samples in reach)."""
     kk = min(k, len(x))
     dist, idx = tree.query(points, k=kk)
     if kk == 1:
         dist, idx = dist[:, None], idx[:, None]
-    g = (dist - scale * rule_f(rule, r[idx], r_at[:, None])).min(axis=1)
+    g: FloatArray = (dist - scale * rule_f(rule, r[idx], r_at[:, None])).min(axis=1)
     if exact:
         # every sample that can lower g lies within g + scale max(r) of the point
         reach = g + scale * np.maximum(r.max(), r_at)
@@ -262,9 +275,9 @@ def coverage_margin(points: np.ndarray, tree: cKDTree, x: np.ndarray, r: np.ndar
     return g
 
 
-def box_covered_by_one(centres: np.ndarray, side: np.ndarray, tree: cKDTree, x: np.ndarray,
-                       r: np.ndarray, rule: str, scale: float, r_lo: np.ndarray,
-                       k: int = 12) -> np.ndarray:
+def box_covered_by_one(centres: FloatArray, side: FloatArray, tree: cKDTree, x: FloatArray,
+                       r: FloatArray, rule: str, scale: float, r_lo: FloatArray,
+                       k: int = 12) -> BoolArray:
     """Boxes (centre, side) wholly inside one sample's disk, r over the box being >= r_lo."""
     kk = min(k, len(x))
     _, idx = tree.query(centres, k=kk)
@@ -273,20 +286,21 @@ def box_covered_by_one(centres: np.ndarray, side: np.ndarray, tree: cKDTree, x: 
     far = np.abs(x[idx] - centres[:, None, :]) + side / 2
     maxd = np.sqrt((far ** 2).sum(axis=2))
     reach = scale * rule_f(rule, r[idx], r_lo[:, None])
-    return ((reach > 0) & (maxd <= reach)).any(axis=1)
+    covered: BoolArray = ((reach > 0) & (maxd <= reach)).any(axis=1)
+    return covered
 
 
 @dataclass
 class MaximalityReport:
     gaps: int                 # centres found uncovered (g > tol)
-    worst_gap: np.ndarray | None
+    worst_gap: FloatArray | None
     boxes: int                # boxes examined
     unresolved_bound: float   # sup of g over boxes left at the stopping size (relative to r)
     probes_max_rel: float     # max of g / r over random probes
 
 
-def check_maximal(x: np.ndarray, r: np.ndarray, rule: str, scale: float, sizing: Sizing,
-                  lo: np.ndarray, hi: np.ndarray, rel_tol: float = 1e-9, probes: int = 200_000,
+def check_maximal(x: FloatArray, r: FloatArray, rule: str, scale: float, sizing: Sizing,
+                  lo: FloatArray, hi: FloatArray, rel_tol: float = 1e-9, probes: int = 200_000,
                   seed: int = 0, max_boxes: int = 20_000_000, *,
                   periodic: Periodic = None, stop_at_gap: bool = False) -> MaximalityReport:
     """Every point of the box within scale f of a sample (branch-and-bound, then probes); with
@@ -376,7 +390,11 @@ def table1_bounds(rule: str, L: float) -> tuple[float, float, float]:
     return 1 / (1 + L), 2 / (1 - L), (1 - L) / 2
 
 
-def _interior_triangles(x: np.ndarray, lo: np.ndarray, hi: np.ndarray, disk_inside: bool = False):
+Triple = tuple[FloatArray, FloatArray, FloatArray]  # per vertex of each triangle (or the side opposite it)
+
+
+def _interior_triangles(x: FloatArray, lo: FloatArray, hi: FloatArray, disk_inside: bool = False
+                        ) -> tuple[IndexArray, Triple, FloatArray, FloatArray, Triple]:
     """Delaunay triangles whose circumcentre lies in the box (where maximality bounds them), or
     with `disk_inside` whose whole circumdisk does: vertex indices, edge lengths opposite each
     vertex, circumcentres, circumradii, angles."""
@@ -401,14 +419,14 @@ def _interior_triangles(x: np.ndarray, lo: np.ndarray, hi: np.ndarray, disk_insi
     return s, (la, lb, lc), u, np.linalg.norm(a - u, axis=1), (ang_a, ang_b, ang_c)
 
 
-def _edge_ratios(s: np.ndarray, lengths, r: np.ndarray) -> np.ndarray:
+def _edge_ratios(s: IndexArray, lengths: Triple, r: FloatArray) -> FloatArray:
     la, lb, lc = lengths
     return np.concatenate([la / r[s[:, 1]], la / r[s[:, 2]], lb / r[s[:, 2]], lb / r[s[:, 0]],
                            lc / r[s[:, 0]], lc / r[s[:, 1]]])
 
 
-def check_delaunay(x: np.ndarray, r: np.ndarray, rule: str, L: float, lo: np.ndarray,
-                   hi: np.ndarray, sizing: Sizing | None = None) -> DelaunayReport:
+def check_delaunay(x: FloatArray, r: FloatArray, rule: str, L: float, lo: FloatArray,
+                   hi: FloatArray, sizing: Sizing | None = None) -> DelaunayReport:
     """Table 1 on triangles whose circumcentre lies in the box (where maximality holds)."""
     s, lengths, u, R, angles = _interior_triangles(x, lo, hi)
     min_angle = float(np.degrees(np.minimum(np.minimum(*angles[:2]), angles[2]).min()))
@@ -426,14 +444,14 @@ def check_delaunay(x: np.ndarray, r: np.ndarray, rule: str, L: float, lo: np.nda
 class Spectrum:
     """Point Set Analysis (Schlomer 2011) of a 2D set normalised to the unit square."""
 
-    frequencies: np.ndarray   # integer frequencies -K..K along each axis
-    power: np.ndarray         # periodogram |sum exp(-2 pi i f.x)|^2 / n, DC removed
-    radii: np.ndarray         # annulus centres |f|
-    radial_mean: np.ndarray   # mean power per annulus
-    anisotropy_db: np.ndarray  # 10 log10(variance / mean^2) per annulus
+    frequencies: IndexArray     # integer frequencies -K..K along each axis
+    power: FloatArray         # periodogram |sum exp(-2 pi i f.x)|^2 / n, DC removed
+    radii: FloatArray         # annulus centres |f|
+    radial_mean: FloatArray   # mean power per annulus
+    anisotropy_db: FloatArray  # 10 log10(variance / mean^2) per annulus
 
 
-def spectrum(x: np.ndarray, lo: np.ndarray, hi: np.ndarray, k_max: Optional[int] = None,
+def spectrum(x: FloatArray, lo: FloatArray, hi: FloatArray, k_max: Optional[int] = None,
              max_points: int = 10_000, seed: int = 0) -> Spectrum:
     """Periodogram with the DC removed, radial mean power and anisotropy (the paper's
     Figures 6-8). Large sets are subsampled to max_points (uniformly, without replacement).
@@ -456,10 +474,12 @@ def spectrum(x: np.ndarray, lo: np.ndarray, hi: np.ndarray, k_max: Optional[int]
     var = np.array([power[which == b].var() for b in bins])
     with np.errstate(divide="ignore", invalid="ignore"):
         aniso = 10 * np.log10(var / mean ** 2)
-    return Spectrum(f, power, bins + 0.5, mean, aniso)
+    # bins + 0.5 is float64; numpy's annotations say only floating
+    return Spectrum(f, power, cast(FloatArray, bins + 0.5), mean, aniso)
 
 
-def delaunay_histograms(x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+def delaunay_histograms(x: FloatArray, r: FloatArray, lo: FloatArray, hi: FloatArray
+                        ) -> tuple[FloatArray, FloatArray]:
     """Minimum angle (degrees) of each triangle whose circumcentre is in the box, and the edge
     length / r(x) ratios of their edges (both endpoints)."""
     s, lengths, _, _, angles = _interior_triangles(x, lo, hi)
@@ -498,8 +518,8 @@ class TwoRadiiDelaunayReport:
         return out
 
 
-def check_delaunay_two_radii(x: np.ndarray, radius: float, t: float, inhibition: float,
-                             coverage: float, lo: np.ndarray, hi: np.ndarray,
+def check_delaunay_two_radii(x: FloatArray, radius: float, t: float, inhibition: float,
+                             coverage: float, lo: FloatArray, hi: FloatArray,
                              disk_inside: bool = True) -> TwoRadiiDelaunayReport:
     """Prop. 4.1 (|e| in [R_f, 2R], R <= R_c) and Prop. 4.2 (sin a >= |e| / 2R, so the smallest
     angle is at least arcsin(R_f / 2R_c): 30 deg for equal radii, 14.48 deg for R_c = 2 R_f)
@@ -532,13 +552,13 @@ class TilingReport:
     maximality: MaximalityReport   # over a tile-sized window of the tiled copy, seams inside
 
 
-def _symmetric_f(rule: str, ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
+def _symmetric_f(rule: str, ra: FloatArray, rb: FloatArray) -> FloatArray:
     """f for a pair without an order: conflicting in both orders (prior, current: the smaller r)."""
     return np.maximum(ra, rb) if rule == "bigger" else np.minimum(ra, rb)
 
 
-def check_tiling(x: np.ndarray, r: np.ndarray, rule: str, sizing: Sizing, lo: np.ndarray,
-                 hi: np.ndarray, periodic: Periodic, conflict_scale: float, cover_scale: float,
+def check_tiling(x: FloatArray, r: FloatArray, rule: str, sizing: Sizing, lo: FloatArray,
+                 hi: FloatArray, periodic: Periodic, conflict_scale: float, cover_scale: float,
                  shift: float = 0.5, rel_tol: float = 1e-12, probes: int = 50_000,
                  stop_at_gap: bool = False) -> TilingReport:
     """A 3^p tiled copy of a periodic output is itself a valid sampling: no two of its points
@@ -569,9 +589,9 @@ def check_tiling(x: np.ndarray, r: np.ndarray, rule: str, sizing: Sizing, lo: np
 # -- the continuous stream: prefixes --------------------------------------------------------------
 
 
-def probe_coverage(x: np.ndarray, r: np.ndarray, rule: str, scale: float, sizing: Sizing,
-                   lo: np.ndarray, hi: np.ndarray, probes: int = 20_000, seed: int = 0, *,
-                   periodic: Periodic = None) -> tuple[int, float, Optional[np.ndarray]]:
+def probe_coverage(x: FloatArray, r: FloatArray, rule: str, scale: float, sizing: Sizing,
+                   lo: FloatArray, hi: FloatArray, probes: int = 20_000, seed: int = 0, *,
+                   periodic: Periodic = None) -> tuple[int, float, Optional[FloatArray]]:
     """(gaps, max g / r, worst probe) over random probes of the box (and its corners): the cheap,
     incomplete maximality check, for when the branch-and-bound would cost too much."""
     lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
@@ -602,7 +622,7 @@ class PrefixTauReport:
     conflicts: int             # insertion-order pairs closer than tau inhibition (1 - rel_tol) f
     gaps: int                  # uncovered points found at tau coverage f
     worst: float               # max g / r found (g > 0: uncovered); B&B: its unresolved bound too
-    worst_gap: Optional[np.ndarray]
+    worst_gap: Optional[FloatArray]
     exhaustive: bool           # branch-and-bound (True) or random probes (False)
     maximality_checked: bool   # False for tau below the last t (the record ends before tau)
 
@@ -612,19 +632,19 @@ class PrefixReport:
     nonincreasing: bool
     first_increase: int        # index k with t_k > t_{k-1}, or -1
     conflicts_at_insertion: int  # pairs closer than t_i inhibition (1 - rel_tol) f: all taus
-    taus: list
+    taus: list[PrefixTauReport]
 
     @property
     def ok(self) -> bool:
         return (self.nonincreasing and self.conflicts_at_insertion == 0 and
                 all(p.conflicts == 0 and p.gaps == 0 for p in self.taus))
 
-    def failures(self) -> list:
+    def failures(self) -> list[PrefixTauReport]:
         return [p for p in self.taus if p.conflicts or p.gaps]
 
 
-def check_prefixes(x: np.ndarray, r: np.ndarray, t: np.ndarray, rule: str, inhibition: float,
-                   coverage: float, sizing: Sizing, lo: np.ndarray, hi: np.ndarray,
+def check_prefixes(x: FloatArray, r: FloatArray, t: FloatArray, rule: str, inhibition: float,
+                   coverage: float, sizing: Sizing, lo: FloatArray, hi: FloatArray,
                    taus: Sequence[float], rel_tol: float, periodic: Periodic = None, *,
                    bnb_taus: Sequence[float] = (), probes: int = 20_000, seed: int = 0,
                    bnb_rel_tol: float = 1e-9) -> PrefixReport:
@@ -681,8 +701,8 @@ def check_prefixes(x: np.ndarray, r: np.ndarray, t: np.ndarray, rule: str, inhib
     return PrefixReport(first_increase < 0, first_increase, len(pi), reports)
 
 
-def _margin_at(y: np.ndarray, x: np.ndarray, r: np.ndarray, rule: str, scale: float,
-               sizing: Sizing, lo: np.ndarray, hi: np.ndarray, periodic: Periodic) -> float:
+def _margin_at(y: FloatArray, x: FloatArray, r: FloatArray, rule: str, scale: float,
+               sizing: Sizing, lo: FloatArray, hi: FloatArray, periodic: Periodic) -> float:
     """g(y) / r(y) exactly, at one point of the box."""
     if _periodic_mask(periodic, x.shape[1]) is not None:
         x, r, _ = periodic_images(x, r, lo, hi, periodic)
@@ -695,7 +715,7 @@ def _margin_at(y: np.ndarray, x: np.ndarray, r: np.ndarray, rule: str, scale: fl
 # -- uniform radius: the exact farthest point -----------------------------------------------------
 
 
-def _circumcentres(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _circumcentres(p: FloatArray) -> tuple[FloatArray, BoolArray]:
     """Circumcentres of simplices p (m, d+1, d) and a mask of the non-degenerate ones."""
     a = 2 * (p[:, 1:, :] - p[:, :1, :])
     b = (p[:, 1:, :] ** 2).sum(axis=2) - (p[:, :1, :] ** 2).sum(axis=2)
@@ -708,8 +728,8 @@ def _circumcentres(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return c, ok
 
 
-def largest_empty_ball(x: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                       periodic: Periodic = None) -> tuple[np.ndarray, float]:
+def largest_empty_ball(x: FloatArray, lo: FloatArray, hi: FloatArray,
+                       periodic: Periodic = None) -> tuple[FloatArray, float]:
     """(y, R): the point of the box farthest from the samples x and its distance (toroidal along
     periodic axes), exact up to round-off, in 2D and 3D (any d scipy's Delaunay takes).
     Samples may lie outside the box.
@@ -740,7 +760,7 @@ def largest_empty_ball(x: np.ndarray, lo: np.ndarray, hi: np.ndarray,
     if mask is not None:
         imgs, _, _ = periodic_images(x, np.zeros(len(x)), lo, hi, mask, margin=2 * U)
         tree = cKDTree(imgs)
-    aug = [imgs]
+    parts = [imgs]
     for k in np.flatnonzero(~pmask):
         for face, side in ((lo[k], 1.0), (hi[k], -1.0)):
             # a sample beyond the face (a fixed point) is not mirrored: its mirror would be a
@@ -749,9 +769,9 @@ def largest_empty_ball(x: np.ndarray, lo: np.ndarray, hi: np.ndarray,
             near = (gap >= 0) & (gap <= U)
             mir = imgs[near].copy()
             mir[:, k] = 2 * face - mir[:, k]
-            aug.append(mir)
-    aug = np.concatenate(aug)
-    cand = [corners]
+            parts.append(mir)
+    aug = np.concatenate(parts)
+    found = [corners]
     if len(aug) >= d + 1:
         try:
             tri = Delaunay(aug)
@@ -759,10 +779,10 @@ def largest_empty_ball(x: np.ndarray, lo: np.ndarray, hi: np.ndarray,
             c = c[ok]
             tol = 1e-12 * float(np.abs(hi - lo).max())
             c = c[np.all((c >= lo - tol) & (c <= hi + tol), axis=1)]
-            cand.append(np.clip(c, lo, hi))
+            found.append(np.clip(c, lo, hi))
         except Exception:  # noqa: BLE001 - too few or degenerate points: the grid and corners
-            cand.append(nodes)
-    cand = np.concatenate(cand)
+            found.append(nodes)
+    cand = np.concatenate(found)
     dist = tree.query(cand)[0]
     w = int(np.argmax(dist))
     return cand[w], float(dist[w])

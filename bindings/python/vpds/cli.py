@@ -13,9 +13,11 @@ from pathlib import Path
 from typing import Any, Optional, Sequence
 
 import numpy as np
+import numpy.typing as npt
 
 from ._core import RULES, PoissonDisk, VpdsError
 from ._optional import MissingDependencyError, require
+from ._typing import SizingFunction
 from .cli_common import UsageError, domain_from_file, floats_arg, periodic_arg, sizing_from_expression
 from .estimate import available_memory, estimate_run
 from .files import check_output, write_points
@@ -24,9 +26,11 @@ from .files import check_output, write_points
 _STEP = 20_000
 
 
-def _sizing(args: argparse.Namespace, lo: np.ndarray, hi: np.ndarray) -> tuple[Any, dict, dict]:
-    """The sizing the options name, the parameters a file records for it, and its arrays."""
-    meta: dict = {}
+def _sizing(args: argparse.Namespace, lo: npt.NDArray[np.float64], hi: npt.NDArray[np.float64]
+            ) -> tuple[Optional[SizingFunction], dict[str, Any], dict[str, npt.NDArray[np.float64]]]:
+    """The sizing the options name (a SizingGrid is one too: callable on points), the
+    parameters a file records for it, and its arrays."""
+    meta: dict[str, Any] = {}
     if args.sizing:
         meta.update(sizing=args.sizing, lipschitz=args.lipschitz)  # no L: the C message says so
         return sizing_from_expression(args.sizing, args.dim), meta, {}
@@ -47,8 +51,8 @@ def _sizing(args: argparse.Namespace, lo: np.ndarray, hi: np.ndarray) -> tuple[A
     return None, meta, {}
 
 
-def _check_size(args: argparse.Namespace, engine: PoissonDisk, sizing: Any, lo: np.ndarray,
-                hi: np.ndarray, domain: Any) -> float:
+def _check_size(args: argparse.Namespace, engine: PoissonDisk, sizing: Optional[SizingFunction],
+                lo: npt.NDArray[np.float64], hi: npt.NDArray[np.float64], domain: object) -> float:
     """The expected count; refuse a run that will not fit in memory unless --force."""
     scale = min([1.0] + [float(v) for v in args.refine.split(",")]) if args.refine else 1.0
     if args.stream:

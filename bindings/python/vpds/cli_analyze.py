@@ -10,14 +10,19 @@ import argparse
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Optional
+from types import ModuleType
+from typing import TYPE_CHECKING, Any, Callable, Optional
 
 import numpy as np
+import numpy.typing as npt
 
 from ._core import RULES
 from ._optional import require
 from .cli_common import UsageError, domain_from_file, floats_arg, sizing_from_expression
 from .files import Record, read_points
+
+if TYPE_CHECKING:  # for the annotations: vpds.analysis needs scipy, imported when run
+    from .analysis import Sizing
 
 EXIT_FAILED, EXIT_UNCHECKED = 1, 3
 
@@ -33,23 +38,24 @@ class Check:
 class Params:
     """What the run promised: from the flags, else the file, else the defaults."""
     dim: int
-    lo: np.ndarray
-    hi: np.ndarray
+    lo: npt.NDArray[np.float64]
+    hi: npt.NDArray[np.float64]
     rule: str
     inhibition: float
     coverage: float
-    periodic: Optional[list]
+    periodic: Optional[list[bool]]
     scale: float
     tolerance: float        # relative: the stream's t is an upper bound (VPDS_STREAM_TOLERANCE)
     mode: str
-    sizing: Any             # analysis.Sizing or None (radii vary and r(x) is unknown)
+    sizing: Optional[Sizing]  # None: radii vary and r(x) is unknown
     sizing_note: str
     domain: Optional[str]
     domain_threshold: float
 
 
-def _sizing(args: argparse.Namespace, rec: Record, meta: dict, dim: int, lo: np.ndarray,
-            hi: np.ndarray, analysis: Any) -> tuple[Any, str]:
+def _sizing(args: argparse.Namespace, rec: Record, meta: dict[str, Any], dim: int,
+            lo: npt.NDArray[np.float64], hi: npt.NDArray[np.float64], analysis: ModuleType
+            ) -> tuple[Optional[Sizing], str]:
     """The sizing r(x) and L to check against, and where they came from."""
     expr = args.sizing or (meta.get("sizing") if args.radius is None else None)
     if expr:
@@ -75,9 +81,10 @@ def _sizing(args: argparse.Namespace, rec: Record, meta: dict, dim: int, lo: np.
     return None, "unknown (radii vary; the file does not record r(x): give --sizing and --lipschitz)"
 
 
-def _params(args: argparse.Namespace, rec: Record, analysis: Any) -> Params:
+def _params(args: argparse.Namespace, rec: Record, analysis: ModuleType) -> Params:
     meta, dim = rec.meta, rec.points.shape[1]
-    pick = (lambda flag, key, default: flag if flag is not None else meta.get(key, default))
+    pick: Callable[[Any, str, Any], Any] = (
+        lambda flag, key, default: flag if flag is not None else meta.get(key, default))
     lo = floats_arg(args.lo, dim, 0.0, "--lo") if args.lo else np.asarray(meta.get("lo", [0.0] * dim), dtype=np.float64)
     hi = floats_arg(args.hi, dim, 1.0, "--hi") if args.hi else np.asarray(meta.get("hi", [1.0] * dim), dtype=np.float64)
     if lo.shape != (dim,) or hi.shape != (dim,):
@@ -95,7 +102,7 @@ def _params(args: argparse.Namespace, rec: Record, analysis: Any) -> Params:
                   sizing, note, meta.get("domain"), float(meta.get("domain_threshold") or 0.5))
 
 
-def _empty_disk(rec: Record, p: Params, analysis: Any) -> Check:
+def _empty_disk(rec: Record, p: Params, analysis: ModuleType) -> Check:
     x, r = rec.points, rec.radii
     t = rec.scales if rec.scales is not None else np.full(len(x), p.scale)
     lip = p.sizing.lipschitz if p.sizing is not None else math.inf
@@ -106,13 +113,13 @@ def _empty_disk(rec: Record, p: Params, analysis: Any) -> Check:
                  f"{tol})", "passed" if bad == 0 else "FAILED", f"{bad} conflicting pairs")
 
 
-def _maximal(rec: Record, p: Params, analysis: Any) -> Check:
+def _maximal(rec: Record, p: Params, analysis: ModuleType) -> Check:
     name = f"maximality at t = {p.scale:g}"
     if p.sizing is None:
         return Check(name, "not checked", "r(x) is unknown: give --sizing and --lipschitz")
     s_c = p.scale * p.coverage
     if p.domain is not None:
-        return _maximal_in_domain(rec, p, analysis, name, s_c)
+        return _maximal_in_domain(rec, p, analysis, name, s_c, p.domain, p.sizing)
     try:
         rep = analysis.check_maximal(rec.points, rec.radii, p.rule, s_c, p.sizing, p.lo, p.hi,
                                      periodic=p.periodic)
@@ -123,14 +130,16 @@ def _maximal(rec: Record, p: Params, analysis: Any) -> Check:
                  "passed" if ok else "FAILED", f"{rep.gaps} uncovered points, {rep.boxes} boxes")
 
 
-def _maximal_in_domain(rec: Record, p: Params, analysis: Any, name: str, s_c: float) -> Check:
-    """Probes of the domain only: the branch-and-bound covers boxes, not a domain's boundary."""
+def _maximal_in_domain(rec: Record, p: Params, analysis: ModuleType, name: str, s_c: float,
+                       domain: str, sizing: Sizing) -> Check:
+    """Probes of the domain only: the branch-and-bound covers boxes, not a domain's boundary.
+    `domain` and `sizing` are p's, known here (not None)."""
     from .domain import as_domain
-    dom = as_domain(domain_from_file(Path(p.domain)), p.dim, p.lo, p.hi, p.domain_threshold)
+    dom = as_domain(domain_from_file(Path(domain)), p.dim, p.lo, p.hi, p.domain_threshold)
     rng = np.random.default_rng(0)
     y = p.lo + (p.hi - p.lo) * rng.random((200_000, p.dim))
     y = y[dom(y) <= 0]
-    ry = p.sizing.fn(y)
+    ry = sizing.fn(y)
     tree = require("scipy.spatial", "vpds analyze", "scipy").cKDTree(rec.points)
     g = analysis.coverage_margin(y, tree, rec.points, rec.radii, p.rule, s_c, ry, exact=True)
     gaps = int(np.count_nonzero(g > 1e-9 * ry))
@@ -140,7 +149,7 @@ def _maximal_in_domain(rec: Record, p: Params, analysis: Any, name: str, s_c: fl
                  "covered): no exhaustive search inside a domain's boundary")
 
 
-def _table1(rec: Record, p: Params, analysis: Any) -> Optional[Check]:
+def _table1(rec: Record, p: Params, analysis: ModuleType) -> Optional[Check]:
     if p.dim != 2 or len(rec.points) < 3:
         return None
     name = "Delaunay bounds (Table 1)"
@@ -153,6 +162,7 @@ def _table1(rec: Record, p: Params, analysis: Any) -> Optional[Check]:
         if p.sizing.lipschitz != 0:
             return Check("Delaunay bounds (Prop. 4.1-4.2)", "not checked",
                          "two radii with a varying r: no bound implemented")
+        assert rec.radii is not None  # cmd_analyze fills in the radii a file lacks
         rep = analysis.check_delaunay_two_radii(rec.points, float(rec.radii[0]), p.scale,
                                                 p.inhibition * (1 - p.tolerance), p.coverage,
                                                 p.lo, p.hi)
@@ -209,7 +219,7 @@ def cmd_analyze(args: argparse.Namespace) -> int:
     return _verdict(checks)
 
 
-def _verdict(checks: list) -> int:
+def _verdict(checks: list[Check]) -> int:
     failed = [c.name for c in checks if c.status == "FAILED"]
     unchecked = [c.name for c in checks if c.status == "not checked"]
     if failed:
@@ -223,7 +233,8 @@ def _verdict(checks: list) -> int:
     return 0
 
 
-def add_analyze_parser(sub: Any, fmt: Any) -> None:
+def add_analyze_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser],
+                       fmt: type[argparse.HelpFormatter]) -> None:
     a = sub.add_parser("analyze", formatter_class=fmt, help="check a sampling's guarantees and "
                        "plot its spectrum (needs scipy)", description=__doc__)
     a.add_argument("file", help=".npz, .npy, .csv, .ply or a .zarr tile store, as `vpds sample` "

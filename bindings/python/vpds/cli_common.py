@@ -5,11 +5,15 @@ from __future__ import annotations
 import ast
 import math
 from pathlib import Path
-from typing import Any, Callable, Optional
+from typing import TYPE_CHECKING, Any, Callable, Optional, Union
 
 import numpy as np
+import numpy.typing as npt
 
 from ._optional import require
+
+if TYPE_CHECKING:  # for the annotation: vpds.domain loads the C extension
+    from .domain import GeometryLike
 
 __all__ = ["UsageError", "domain_from_file", "floats_arg", "periodic_arg", "sizing_from_expression", "EXPR_NAMES"]
 
@@ -26,7 +30,7 @@ EXPR_NAMES["np"] = np
 
 
 def sizing_from_expression(expr: str, dim: int, option: str = "--sizing"
-                           ) -> Callable[[np.ndarray], np.ndarray]:
+                           ) -> Callable[[npt.NDArray[np.float64]], npt.NDArray[np.float64]]:
     """r(x) from a numpy expression in x, where x[k] is the k-th coordinate of all points.
     A syntax error, an unknown name or a value that is not a radius is a UsageError."""
     try:
@@ -41,9 +45,10 @@ def sizing_from_expression(expr: str, dim: int, option: str = "--sizing"
                          f"x[{dim - 1}] and {', '.join(sorted(EXPR_NAMES))})")
     code = compile(tree, f"<{option}>", "eval")
 
-    def sizing(points: np.ndarray) -> np.ndarray:
+    def sizing(points: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         value = eval(code, {"__builtins__": {}}, dict(EXPR_NAMES, x=points.T))  # noqa: S307
-        return np.broadcast_to(np.asarray(value, dtype=np.float64), (len(points),)).copy()
+        r: npt.NDArray[np.float64] = np.broadcast_to(np.asarray(value, dtype=np.float64), (len(points),)).copy()
+        return r
     probe = np.full((1, dim), 0.5)
     try:
         with np.errstate(all="ignore"):
@@ -57,7 +62,7 @@ def sizing_from_expression(expr: str, dim: int, option: str = "--sizing"
     return sizing
 
 
-def floats_arg(text: Optional[str], dim: int, default: float, option: str) -> np.ndarray:
+def floats_arg(text: Optional[str], dim: int, default: float, option: str) -> npt.NDArray[np.float64]:
     """--lo / --hi: one value for every axis, or `dim` comma-separated finite values."""
     if text is None:
         return np.full(dim, default)
@@ -74,7 +79,7 @@ def floats_arg(text: Optional[str], dim: int, default: float, option: str) -> np
     return np.array(values)
 
 
-def periodic_arg(text: Optional[str], dim: int) -> Optional[list]:
+def periodic_arg(text: Optional[str], dim: int) -> Optional[list[bool]]:
     """--periodic: comma-separated axis indices, or 'all'."""
     if not text:
         return None
@@ -91,16 +96,18 @@ def periodic_arg(text: Optional[str], dim: int) -> Optional[list]:
     return [k in axes for k in range(dim)]
 
 
-def domain_from_file(path: Path) -> Any:
+def domain_from_file(path: Path) -> Union[npt.NDArray[Any], GeometryLike, str]:
     """--domain FILE: an image (.png, .exr, ...: a mask over the box), a .npy array (a mask
     with one axis per dimension, or (m, 2) polygon vertices), or a .wkt polygon (shapely)."""
     if not path.is_file():
         raise UsageError(f"--domain {path}: no such file")
     try:
         if path.suffix.lower() == ".npy":
-            return np.load(path, allow_pickle=False)
+            array: npt.NDArray[Any] = np.load(path, allow_pickle=False)
+            return array
         if path.suffix.lower() == ".wkt":
-            return require("shapely.wkt", "--domain .wkt", "shapely").loads(path.read_text())
+            polygon: GeometryLike = require("shapely.wkt", "--domain .wkt", "shapely").loads(path.read_text())
+            return polygon
     except (OSError, ValueError) as exc:
         raise UsageError(f"--domain {path}: cannot read it: {exc}") from None
     return str(path)

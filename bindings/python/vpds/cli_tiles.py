@@ -5,11 +5,14 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
 from .cli_common import UsageError
+
+if TYPE_CHECKING:  # for the annotation: vpds.tiling loads the C extension
+    from .tiling import SizingArg
 
 
 def add_tile_arguments(s: argparse.ArgumentParser, plain: Callable[[argparse.Namespace], int]) -> None:
@@ -44,7 +47,7 @@ def cmd_sample_tiles(args: argparse.Namespace) -> int:
         raise UsageError(f"--tiles has {len(counts)} counts for --dim {dim}")
     lo = _floats(args.lo, dim, 0.0, "--lo")
     hi = _floats(args.hi, dim, 1.0, "--hi")
-    sizing = None
+    sizing: SizingArg = None
     if args.sizing:
         if args.radius_max is None:
             raise UsageError("--sizing with --tiles needs --radius-max (an upper bound "

@@ -17,13 +17,17 @@ import os
 import shutil
 import uuid
 from pathlib import Path
-from typing import Any, Callable, Iterable, Optional, Sequence, Union
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Optional, Sequence, Union
 
 import numpy as np
 
 from .gridsource import GridSource
 from .tilestore import TileStore
+from ._typing import BoundsLike, RngLike
 from .tiling import SizingArg, Tiling, TilingSpec
+
+if TYPE_CHECKING:  # for the annotations: dask is imported when sample() runs
+    from distributed import Client, Future
 
 __all__ = ["sample", "run_local", "GridSource", "TileStore", "TilingSpec", "Tiling"]
 
@@ -67,23 +71,26 @@ def _open_store(store: Union[str, Path], spec: TilingSpec, tiling: Tiling, overw
 
 def _spec(d: int, tiles: Union[int, Sequence[int]], **kw: Any) -> TilingSpec:
     if isinstance(kw.get("sizing"), (str, os.PathLike)):
-        kw["sizing"] = GridSource(kw["sizing"], kw.get("l_bounds") or [0.0] * d,
-                                  kw.get("u_bounds") or [1.0] * d)
+        # `is None`, not `or`: bounds given as numpy arrays have no truth value
+        lo, hi = kw.get("l_bounds"), kw.get("u_bounds")
+        kw["sizing"] = GridSource(kw["sizing"], [0.0] * d if lo is None else lo,
+                                  [1.0] * d if hi is None else hi)
     return TilingSpec.make(d, tiles if not isinstance(tiles, int) else [tiles] * d, **kw)
 
 
 def sample(store: Union[str, Path], d: int, tiles: Union[int, Sequence[int]], *,
-           l_bounds: Optional[Sequence[float]] = None, u_bounds: Optional[Sequence[float]] = None,
-           radius: float = 0.05, sizing: Union[SizingArg, str] = None,
+           l_bounds: Optional[BoundsLike] = None, u_bounds: Optional[BoundsLike] = None,
+           radius: float = 0.05, sizing: Union[SizingArg, str, os.PathLike[str]] = None,
            lipschitz: Optional[float] = None, rule: str = "smaller", inhibition: float = 1.0,
            coverage: float = 1.0, periodic: Optional[Sequence[bool]] = None,
            weighted: bool = False, radius_min: Optional[float] = None,
-           radius_max: Optional[float] = None, rng: Any = 0, scale: float = 1.0,
-           address: Optional[str] = None, client: Any = None, n_workers: Optional[int] = None,
+           radius_max: Optional[float] = None, rng: RngLike = 0, scale: float = 1.0,
+           address: Optional[str] = None, client: Optional[Client] = None, n_workers: Optional[int] = None,
            progress: bool = True, overwrite: bool = False,
            on_tile: Optional[Callable[[int, int], None]] = None) -> TileStore:
-    """Sample the box [l_bounds, u_bounds] as `tiles` tiles per axis into the Zarr store at
-    `store`, on Dask, and return the store (a reader that streams the tiles back).
+    """Sample the box [l_bounds, u_bounds] (each of shape (d,); default 0 and 1) as `tiles` tiles
+    per axis into the Zarr store at `store`, on Dask, and return the store (a reader that streams
+    the tiles back).
 
     The sampling arguments are PoissonDisk's (`sizing`: a float, a numpy grid in memory, a
     `GridSource` or a path to a .npy / .zarr / .exr grid read one window per tile, or a
@@ -114,7 +121,7 @@ def sample(store: Union[str, Path], d: int, tiles: Union[int, Sequence[int]], *,
             client = Client(own_cluster)
     own_client = own_cluster is not None or address is not None
     bar = None
-    futures: dict = {}
+    futures: dict[int, Future[int]] = {}
     try:
         if progress:
             try:

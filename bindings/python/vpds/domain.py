@@ -15,15 +15,17 @@ from __future__ import annotations
 
 import math
 import os
-from typing import Any, Callable, Optional, Sequence
+from typing import Any, Optional, Protocol, Sequence, Union
 
 import numpy as np
+import numpy.typing as npt
 
 from ._callbacks import as_values, escaped, keep
 from ._errors import created
+from ._typing import BoundsLike, DomainFunction
 from ._vpds import ffi, lib
 
-__all__ = ["Domain", "as_domain", "estimate_radius", "JAMMING_DENSITY"]
+__all__ = ["Domain", "DomainLike", "GeometryLike", "as_domain", "estimate_radius", "JAMMING_DENSITY"]
 
 #: Saturation (jamming) density of random sequential addition of equal balls, by dimension: the
 #: fraction of space the balls of radius r/2 cover in a maximal set of conflict distance r.
@@ -44,11 +46,13 @@ def estimate_radius(n: int, d: int, volume: float = 1.0) -> float:
     if not volume > 0 or not math.isfinite(volume):
         raise ValueError(f"volume = {volume}: must be finite and > 0")
     unit_ball = math.pi ** (d / 2) / math.gamma(d / 2 + 1)
-    return 2.0 * (JAMMING_DENSITY[d] * volume / (n * unit_ball)) ** (1.0 / d)
+    # annotated: float ** float is Any to mypy (a negative base would give a complex)
+    r: float = 2.0 * (JAMMING_DENSITY[d] * volume / (n * unit_ball)) ** (1.0 / d)
+    return r
 
 
 @ffi.def_extern(error=float("nan"), onerror=escaped("error"))
-def vpds_py_domain(x, user):  # type: ignore[no-untyped-def]
+def vpds_py_domain(x: Any, user: Any) -> float:
     """Called by the C library at one point: the Python sdf on a (1, d) array. An exception is
     kept in the Domain's `error` and signalled by NaN (the library stops with VPDS_ERR_DOMAIN;
     the binding raises the exception itself); after one, every call returns NaN at once until
@@ -67,8 +71,10 @@ def vpds_py_domain(x, user):  # type: ignore[no-untyped-def]
 class Domain:
     """A domain function for the C library, and the objects it needs kept alive."""
 
+    _handle: Any  # from_callable's: the cffi handle `user` points through, kept alive here
+
     def __init__(self, d: int, fn_ptr: Any, user: Any, keep: Sequence[Any] = (),
-                 sdf: Optional[Callable[[np.ndarray], np.ndarray]] = None):
+                 sdf: Optional[DomainFunction] = None) -> None:
         self.d = d
         self.fn_ptr = fn_ptr
         self.user = user
@@ -76,8 +82,8 @@ class Domain:
         self.fn = sdf
         self.error: Optional[BaseException] = None
 
-    def __call__(self, x: Any) -> np.ndarray:
-        """The signed distance at points of shape (m, d)."""
+    def __call__(self, x: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """The signed distance at points of shape (m, d) (or one point (d,)): shape (m,)."""
         pts = np.ascontiguousarray(np.atleast_2d(x), dtype=np.float64)
         if self.fn is not None:
             return np.asarray(self.fn(pts), dtype=np.float64).reshape(-1)
@@ -85,14 +91,14 @@ class Domain:
                          for p in pts])
 
     @classmethod
-    def from_callable(cls, d: int, fn: Callable[[np.ndarray], np.ndarray]) -> "Domain":
+    def from_callable(cls, d: int, fn: DomainFunction) -> "Domain":
         dom = cls(d, lib.vpds_py_domain, None, sdf=fn)
-        dom._handle = ffi.new_handle(dom)  # type: ignore[attr-defined]
-        dom.user = dom._handle  # type: ignore[attr-defined]
+        dom._handle = ffi.new_handle(dom)
+        dom.user = dom._handle
         return dom
 
     @classmethod
-    def polygon(cls, rings: Sequence[Any]) -> "Domain":
+    def polygon(cls, rings: Sequence[npt.ArrayLike]) -> "Domain":
         """A 2D polygon set from rings of (m, 2) vertices (a ring inside another is a hole)."""
         arrs = [np.ascontiguousarray(r, dtype=np.float64).reshape(-1, 2) for r in rings]
         arrs = [a[:-1] if len(a) > 1 and np.array_equal(a[0], a[-1]) else a for a in arrs]
@@ -107,9 +113,10 @@ class Domain:
                            lib.vpds_polygon_destroy, "vpds_polygon", desc))
 
     @classmethod
-    def mask(cls, values: Any, lo: Sequence[float], hi: Sequence[float],
+    def mask(cls, values: npt.ArrayLike, lo: BoundsLike, hi: BoundsLike,
              threshold: float = 0.5) -> "Domain":
-        """A mask over the box [lo, hi]: inside where value >= threshold (True for booleans)."""
+        """A mask over the box [lo, hi] (each (d,)), `values` with one axis per dimension (C
+        order): inside where value >= threshold (True for booleans)."""
         v = np.asarray(values)
         if v.dtype == bool:
             v = v.astype(np.float64)
@@ -131,7 +138,7 @@ class Domain:
                            "vpds_mask", desc))
 
 
-def _rings_of_shapely(geom: Any) -> list:
+def _rings_of_shapely(geom: Any) -> list[npt.NDArray[Any]]:
     polys = list(geom.geoms) if geom.geom_type == "MultiPolygon" else [geom]
     rings = []
     for p in polys:
@@ -142,7 +149,7 @@ def _rings_of_shapely(geom: Any) -> list:
     return rings
 
 
-def read_image(path: "str | os.PathLike[str]") -> np.ndarray:
+def read_image(path: Union[str, os.PathLike[str]]) -> npt.NDArray[np.float64]:
     """An image as float64 (rows, columns): EXR through OpenEXR, others through Pillow (integer
     images scaled to [0, 1]; colour converted to luminance)."""
     if str(path).lower().endswith(".exr"):
@@ -160,7 +167,19 @@ def read_image(path: "str | os.PathLike[str]") -> np.ndarray:
     return arr
 
 
-def as_domain(obj: Any, d: int, lo: Sequence[float], hi: Sequence[float],
+class GeometryLike(Protocol):
+    """A shapely Polygon or MultiPolygon (holes included): as_domain knows one by its geom_type."""
+
+    @property
+    def geom_type(self) -> str: ...
+
+
+#: what `domain` takes (see the module's note): an sdf, a polygon, a mask or an image file
+DomainLike = Union[Domain, DomainFunction, GeometryLike, Sequence[npt.ArrayLike], npt.ArrayLike, str,
+                   os.PathLike[str]]
+
+
+def as_domain(obj: DomainLike, d: int, lo: BoundsLike, hi: BoundsLike,
               threshold: float = 0.5) -> Domain:
     """A Domain from a callable, a polygon, a mask or an image file (see the module's note)."""
     if isinstance(obj, Domain):

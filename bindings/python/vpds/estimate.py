@@ -10,10 +10,11 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
-from typing import Callable, Optional, Sequence
+from typing import Optional
 
 import numpy as np
 
+from ._typing import BoundsLike, DomainFunction, SizingFunction
 from .domain import JAMMING_DENSITY
 
 __all__ = ["Estimate", "estimate_run", "available_memory"]
@@ -33,11 +34,12 @@ class Estimate:
         return f"about {self.samples:.3g} samples and {self.bytes / 2**20:,.0f} MiB"
 
 
-def estimate_run(d: int, lo: Sequence[float], hi: Sequence[float], *, radius: float = 0.05,
-                 sizing: Optional[Callable[[np.ndarray], np.ndarray]] = None,
+def estimate_run(d: int, lo: BoundsLike, hi: BoundsLike, *, radius: float = 0.05,
+                 sizing: Optional[SizingFunction] = None,
                  inhibition: float = 1.0, scale: float = 1.0,
-                 domain: Optional[Callable[[np.ndarray], np.ndarray]] = None) -> Estimate:
-    """Samples and peak bytes of a maximal run at `scale` (the smallest t it reaches)."""
+                 domain: Optional[DomainFunction] = None) -> Estimate:
+    """Samples and peak bytes of a maximal run at `scale` (the smallest t it reaches) over the
+    box [lo, hi] (each of shape (d,)); `sizing` and `domain` are evaluated at points (m, d)."""
     lo_a, hi_a = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
     volume = float(np.prod(hi_a - lo_a))
     unit_ball = math.pi ** (d / 2) / math.gamma(d / 2 + 1)

@@ -8,12 +8,18 @@ are the nodes of a grid interpolated bilinearly. Pixel values are the radii them
 from __future__ import annotations
 
 from os import PathLike
-from typing import Optional, Sequence, Union
+from typing import TYPE_CHECKING, Optional, Sequence, Union
 
 import numpy as np
+import numpy.typing as npt
+
+from ._typing import BoundsLike
+
+if TYPE_CHECKING:  # for the annotation: sizing_grid_from_exr imports it itself, when called
+    from .sizing_grid import SizingGrid
 
 
-def read_channel(path: Union[str, PathLike], channel: Optional[str] = None) -> np.ndarray:
+def read_channel(path: Union[str, PathLike[str]], channel: Optional[str] = None) -> npt.NDArray[np.float64]:
     """One channel as float64, shape (rows, columns); half and float channels alike."""
     try:
         import OpenEXR
@@ -40,9 +46,9 @@ def read_channel(path: Union[str, PathLike], channel: Optional[str] = None) -> n
     return pixels
 
 
-def sizing_grid_from_exr(path: Union[str, PathLike], lo: Sequence[float], hi: Sequence[float],
+def sizing_grid_from_exr(path: Union[str, PathLike[str]], lo: BoundsLike, hi: BoundsLike,
                          channel: Optional[str] = None,
-                         radius_range: Optional[Sequence[float]] = None):
+                         radius_range: Optional[Sequence[float]] = None) -> SizingGrid:
     """A SizingGrid over [lo, hi] from an image (see the module's note on orientation)."""
     from .sizing_grid import SizingGrid
     if len(lo) != 2:

@@ -12,9 +12,10 @@ import os
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, BinaryIO, Callable, Mapping, Optional, cast
 
 import numpy as np
+import numpy.typing as npt
 
 from .cli_common import UsageError
 
@@ -27,12 +28,12 @@ OUTPUT_SUFFIXES = (".npy", ".npz", ".csv", ".ply")
 class Record:
     """A sampling read back: points (n, d), radii, scales t and fixed flags (None when the file
     has none), the run's parameters, and arrays they refer to (a sizing grid)."""
-    points: np.ndarray
-    radii: Optional[np.ndarray]
-    scales: Optional[np.ndarray]
-    fixed: Optional[np.ndarray]
-    meta: dict = field(default_factory=dict)
-    arrays: dict = field(default_factory=dict)
+    points: npt.NDArray[np.float64]
+    radii: Optional[npt.NDArray[np.float64]]
+    scales: Optional[npt.NDArray[np.float64]]
+    fixed: Optional[npt.NDArray[np.bool_]]
+    meta: dict[str, Any] = field(default_factory=dict)
+    arrays: dict[str, npt.NDArray[Any]] = field(default_factory=dict)
 
 
 def check_output(path: Path, dim: int) -> None:
@@ -50,7 +51,7 @@ def check_output(path: Path, dim: int) -> None:
         raise UsageError(f"-o {path}: directory {parent} is not writable")
 
 
-def _atomic(path: Path, write: Any) -> None:
+def _atomic(path: Path, write: Callable[[BinaryIO], None]) -> None:
     """write(file object) into a temporary file beside `path`, then rename it over `path`."""
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent or ".")
     try:
@@ -65,17 +66,21 @@ def _atomic(path: Path, write: Any) -> None:
         raise
 
 
-def write_points(path: Path, x: np.ndarray, r: np.ndarray, t: np.ndarray, fixed: np.ndarray,
-                 meta: Optional[dict] = None, arrays: Optional[dict] = None) -> None:
-    """.npy: the points (n, d); .npz: points, radii, scales, fixed, meta (and `arrays`); .csv:
-    x0.., r, t, fixed; .ply: x, y, z (zero-padded below 3D), radius and t as vertex properties."""
+def write_points(path: Path, x: npt.NDArray[np.float64], r: npt.NDArray[np.float64],
+                 t: npt.NDArray[np.float64], fixed: npt.NDArray[np.bool_],
+                 meta: Optional[dict[str, Any]] = None,
+                 arrays: Optional[dict[str, npt.NDArray[Any]]] = None) -> None:
+    """Samples x (n, d) with r, t and fixed (n,) as .npy: the points; .npz: points, radii, scales,
+    fixed, meta (and `arrays`); .csv: x0.., r, t, fixed; .ply: x, y, z (zero-padded below 3D),
+    radius and t as vertex properties."""
     suffix = path.suffix.lower()
     n, d = x.shape
     info = json.dumps(meta or {}, sort_keys=True)
     if suffix == ".npy":
         _atomic(path, lambda f: np.save(f, x))
     elif suffix == ".npz":
-        extra = {f"meta_{k}": v for k, v in (arrays or {}).items()}
+        # Any: savez's annotations would have **extra hold its allow_pickle flag too
+        extra: dict[str, Any] = {f"meta_{k}": v for k, v in (arrays or {}).items()}
         _atomic(path, lambda f: np.savez(f, points=x, radii=r, scales=t, fixed=fixed,
                                          meta=np.array(info), **extra))
     elif suffix == ".csv":
@@ -88,7 +93,7 @@ def write_points(path: Path, x: np.ndarray, r: np.ndarray, t: np.ndarray, fixed:
         xyz = np.zeros((n, 3))
         xyz[:, :d] = x
 
-        def ply(f: Any) -> None:
+        def ply(f: BinaryIO) -> None:
             f.write(b"ply\nformat ascii 1.0\ncomment libvpds sample\n")
             f.write(f"comment vpds {info}\n".encode())
             f.write(f"element vertex {n}\nproperty double x\nproperty double y\n"
@@ -100,7 +105,7 @@ def write_points(path: Path, x: np.ndarray, r: np.ndarray, t: np.ndarray, fixed:
         raise UsageError(f"-o {path}: use {', '.join(OUTPUT_SUFFIXES)}")
 
 
-def _meta(text: str, path: Path) -> dict:
+def _meta(text: str, path: Path) -> dict[str, Any]:
     try:
         value = json.loads(text)
     except ValueError:
@@ -132,7 +137,7 @@ def read_points(path: Path) -> Record:
     raise UsageError(f"{path}: use .npz, .npy, .csv, .ply or a .zarr store")
 
 
-def _points(x: np.ndarray, path: Path) -> np.ndarray:
+def _points(x: npt.NDArray[Any], path: Path) -> npt.NDArray[np.float64]:
     x = np.asarray(x, dtype=np.float64)
     if x.ndim != 2 or x.shape[1] < 1:
         raise UsageError(f"{path}: points have shape {x.shape}; expected (n, d)")
@@ -168,7 +173,7 @@ def _read_csv(path: Path) -> Record:
     if not dims:
         raise UsageError(f"{path}: no coordinate columns (x0, x1, ... as vpds sample writes)")
     col = {h: i for i, h in enumerate(header)}
-    pick = (lambda h: table[:, col[h]] if h in col else None)
+    pick: Callable[[str], Optional[npt.NDArray[np.float64]]] = (lambda h: table[:, col[h]] if h in col else None)
     fixed = pick("fixed")
     return Record(table[:, dims], pick("r"), pick("t"), None if fixed is None else fixed != 0, meta)
 
@@ -199,7 +204,8 @@ def _read_zarr(path: Path) -> Record:
                          "(resume the run first)")
     x, r, t = store.to_numpy("insertion")
     import zarr
-    meta = dict(zarr.open_group(str(path), mode="r").attrs.get("vpds_cli", {}))
+    # the `vpds sample --tiles` record: a JSON object (cli_tiles.py writes it)
+    meta = dict(cast(Mapping[str, Any], zarr.open_group(str(path), mode="r").attrs.get("vpds_cli", {})))
     params = store.params  # what the tiling itself recorded (a callable sizing only by kind)
     meta.setdefault("dim", params["d"])
     meta.setdefault("lo", params["l_bounds"])

@@ -12,24 +12,36 @@ from __future__ import annotations
 import hashlib
 import os
 from os import PathLike
-from typing import Any, Optional, Sequence, Union
+from typing import Any, Optional, Protocol, Sequence, Union
 
 import numpy as np
+import numpy.typing as npt
 
 from ._errors import created
+from ._typing import BoundsLike
 from ._vpds import ffi, lib
 
-__all__ = ["GridSource"]
+__all__ = ["GridArrayLike", "GridSource"]
 
 _BLOCK_BYTES = 64 << 20  # memory for one block of stats()
+
+
+class GridArrayLike(Protocol):
+    """An array-like grid GridSource reads one window at a time (numpy, Zarr, h5py): a shape,
+    and slicing by a tuple of slices (one per axis)."""
+
+    @property
+    def shape(self) -> tuple[int, ...]: ...
+
+    def __getitem__(self, key: tuple[slice, ...], /) -> Any: ...
 
 
 class GridSource:
     """A sizing grid read per tile. `source`: path (.npy, .zarr, .exr) or an array-like."""
 
-    def __init__(self, source: Union[str, PathLike, Any], l_bounds: Sequence[float],
-                 u_bounds: Sequence[float], *, channel: Optional[str] = None,
-                 radius_range: Optional[Sequence[float]] = None):
+    def __init__(self, source: Union[str, PathLike[str], GridArrayLike], l_bounds: BoundsLike,
+                 u_bounds: BoundsLike, *, channel: Optional[str] = None,
+                 radius_range: Optional[Sequence[float]] = None) -> None:
         self.l_bounds = tuple(float(v) for v in l_bounds)
         self.u_bounds = tuple(float(v) for v in u_bounds)
         self.channel = channel
@@ -51,7 +63,7 @@ class GridSource:
         else:
             self._array = source
         if not self._exr:
-            self.shape = tuple(int(v) for v in self._array.shape)
+            self.shape: tuple[int, ...] = tuple(int(v) for v in self._array.shape)
         if len(self.l_bounds) != self.dim or len(self.u_bounds) != self.dim:
             raise ValueError(f"the grid has {self.dim} axes; the bounds have {len(self.l_bounds)}")
         if any(n < 2 for n in self.shape):
@@ -59,14 +71,14 @@ class GridSource:
         self._stats: Optional[tuple[float, float, float]] = None
 
     # pickles as its path (workers reopen the file), or with the array-like itself
-    def __getstate__(self) -> dict:
+    def __getstate__(self) -> dict[str, Any]:
         state = dict(self.__dict__)
         if self._path is not None:
             state["_array"] = None
         state.pop("_exr_file", None)
         return state
 
-    def __setstate__(self, state: dict) -> None:
+    def __setstate__(self, state: dict[str, Any]) -> None:
         self.__dict__.update(state)
         if self._path is not None:
             if self._exr:
@@ -109,7 +121,7 @@ class GridSource:
         self._exr_file = f
         self.shape = (cols, self._exr_rows)
 
-    def _exr_window(self, lo: Sequence[int], hi: Sequence[int]) -> np.ndarray:
+    def _exr_window(self, lo: Sequence[int], hi: Sequence[int]) -> npt.NDArray[np.float64]:
         rows, cols = self._exr_rows, self.shape[0]
         # grid nodes j in [lo1, hi1) are pixel rows rows-1-j: a strip of scanlines, flipped
         first, last = rows - hi[1], rows - 1 - lo[1]
@@ -124,14 +136,14 @@ class GridSource:
         return np.ascontiguousarray(px.T)
 
     # -- windows -----------------------------------------------------------------------------------
-    def window(self, lo: Sequence[int], hi: Sequence[int]) -> np.ndarray:
+    def window(self, lo: Sequence[int], hi: Sequence[int]) -> npt.NDArray[np.float64]:
         """The values of nodes [lo[k], hi[k]) on each axis, float64."""
         if self._exr:
             return self._exr_window(lo, hi)
         sl = tuple(slice(int(a), int(b)) for a, b in zip(lo, hi))
         return np.ascontiguousarray(np.asarray(self._array[sl], dtype=np.float64))
 
-    def make_window(self, values: np.ndarray, offset: Sequence[int]):
+    def make_window(self, values: npt.NDArray[np.float64], offset: Sequence[int]) -> Any:
         """A C vpds_grid holding `values` at `offset` of this grid (freed with its owner)."""
         d = self.dim
         shape = ffi.new("size_t[]", list(values.shape))

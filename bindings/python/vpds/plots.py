@@ -11,11 +11,22 @@ from __future__ import annotations
 
 import textwrap
 from pathlib import Path
-from typing import Optional
+from types import ModuleType
+from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
+import numpy.typing as npt
 
 from ._optional import require
+from ._typing import FloatArray
+
+if TYPE_CHECKING:  # for the annotations: matplotlib (and scipy) are imported when drawing
+    from matplotlib.axes import Axes
+    from matplotlib.colorbar import Colorbar
+    from matplotlib.colors import Normalize
+    from matplotlib.figure import Figure
+
+    from .analysis import DelaunayReport
 
 MAX_DISKS = 5000        # draw every disk up to this many points (the main panel)
 ZOOM_POINTS = 250       # points the zoom panel aims to hold
@@ -23,7 +34,7 @@ DENSE_PIXELS = 4.0      # a zoom panel when the small radii (5% quantile) are be
 _CMAP = "viridis"
 
 
-def _pyplot():
+def _pyplot() -> ModuleType:
     """matplotlib's pyplot on the Agg backend, or MissingDependencyError naming the install."""
     matplotlib = require("matplotlib", "plotting", "matplotlib")
     matplotlib.use("Agg")
@@ -31,14 +42,14 @@ def _pyplot():
     return plt
 
 
-def _new_figure(**kwargs):
+def _new_figure(**kwargs: Any) -> Figure:
     """A Figure outside pyplot's registry (nothing to close; garbage-collected)."""
     _pyplot()
     from matplotlib.figure import Figure
     return Figure(**kwargs)
 
 
-def _as_points(x, dim: int) -> np.ndarray:
+def _as_points(x: npt.ArrayLike, dim: int) -> FloatArray:
     """x as an (n, d) float array (a flat array: 1D points; none: (0, dim))."""
     x = np.asarray(x, dtype=float)
     if x.size == 0:
@@ -54,7 +65,7 @@ class _View:
     in 3D+ its ball's cross-section with the slice), the sample radii r (for the colour), and
     a sentence saying what was selected."""
 
-    def __init__(self, x: np.ndarray, r: Optional[np.ndarray], lo: np.ndarray, hi: np.ndarray):
+    def __init__(self, x: FloatArray, r: Optional[FloatArray], lo: FloatArray, hi: FloatArray) -> None:
         self.lo = np.asarray(lo, dtype=float).reshape(-1)
         self.hi = np.asarray(hi, dtype=float).reshape(-1)
         x = _as_points(x, len(self.lo))
@@ -81,14 +92,14 @@ class _View:
             self.r, self.rho = r_all, r_all
 
     @property
-    def box(self):
+    def box(self) -> tuple[FloatArray, FloatArray]:
         """(lo, hi) of the two drawn axes (1D: the axis and a unit band)."""
         if self.dim >= 2:
             return self.lo[:2], self.hi[:2]
         return np.array([self.lo[0], -1.0]), np.array([self.hi[0], 1.0])
 
 
-def _norm(r: np.ndarray, has_radii: bool):
+def _norm(r: FloatArray, has_radii: bool) -> Optional[Normalize]:
     """The colour scale of the radii: None for one radius, log when they span over 10x."""
     from matplotlib.colors import LogNorm, Normalize
     if not has_radii or len(r) == 0:
@@ -101,14 +112,15 @@ def _norm(r: np.ndarray, has_radii: bool):
     return Normalize(vmin=r_min, vmax=r_max)
 
 
-def _colours(r: np.ndarray, norm, fallback: str = "tab:blue"):
+def _colours(r: FloatArray, norm: Optional[Normalize], fallback: str = "tab:blue") -> FloatArray:
     import matplotlib
     if norm is None:
         return np.array([matplotlib.colors.to_rgba(fallback)] * len(r)).reshape(len(r), 4)
-    return matplotlib.colormaps[_CMAP](norm(r))
+    rgba: FloatArray = matplotlib.colormaps[_CMAP](norm(r))  # (n, 4), for an array of n values
+    return rgba
 
 
-def _zoom_window(view: _View, k: int = ZOOM_POINTS):
+def _zoom_window(view: _View, k: int = ZOOM_POINTS) -> Optional[tuple[FloatArray, FloatArray]]:
     """(lo, hi) of a square window around the smallest radius holding about k points, inside
     the box (a constant radius: around the point nearest the centre)."""
     u, r = view.u, view.r
@@ -142,8 +154,8 @@ def _is_dense(view: _View, pixels_per_unit: float) -> bool:
 # -- drawing ---------------------------------------------------------------------------------------
 
 
-def _draw_2d(ax, view: _View, norm, *, lo2, hi2, disks: bool, pixels_per_unit: float,
-             dpi: float, window=None):
+def _draw_2d(ax: Axes, view: _View, norm: Optional[Normalize], *, lo2: FloatArray, hi2: FloatArray,
+             disks: bool, pixels_per_unit: float, dpi: float, window: Optional[bool] = None) -> None:
     """The points (and disks) in the rectangle lo2..hi2 of ax; window: only those near it."""
     from matplotlib.collections import EllipseCollection
     u, r, rho = view.u, view.r, view.rho
@@ -170,7 +182,8 @@ def _draw_2d(ax, view: _View, norm, *, lo2, hi2, disks: bool, pixels_per_unit: f
     ax.set_ylabel("x[1]")
 
 
-def _dots(ax, u, r, diameter_px, norm, dpi, exact_up_to: int = 20000):
+def _dots(ax: Axes, u: FloatArray, r: FloatArray, diameter_px: FloatArray,
+          norm: Optional[Normalize], dpi: float, exact_up_to: int = 20000) -> None:
     """A dot per point, coloured by r, diameter_px pixels across. Many points: grouped into 64
     colour levels x 8 sizes, each group one single-colour scatter (Agg blits one marker: ~10x
     faster than per-point colours, and the eye cannot tell 64 levels from a continuum)."""
@@ -195,7 +208,8 @@ def _dots(ax, u, r, diameter_px, norm, dpi, exact_up_to: int = 20000):
                    rasterized=True, zorder=3)
 
 
-def _draw_1d(ax, view: _View, norm, *, lo1: float, hi1: float, disks: bool):
+def _draw_1d(ax: Axes, view: _View, norm: Optional[Normalize], *, lo1: float, hi1: float,
+             disks: bool) -> None:
     """A strip: each point a tick coloured by r, under it its interval [x - r, x + r] (small n),
     on three staggered rows so that neighbours' intervals stay apart."""
     from matplotlib.collections import LineCollection
@@ -205,11 +219,13 @@ def _draw_1d(ax, view: _View, norm, *, lo1: float, hi1: float, disks: bool):
     order = np.argsort(x)
     x, r = x[order], r[order]
     colours = _colours(r, norm)
+    # the ignores: matplotlib's annotations want sequences, where its documentation takes the
+    # arrays given here (segments (n, 2, 2), colours (n, 4))
     if disks and len(x):
         rows = -0.35 - 0.2 * (np.arange(len(x)) % 3)
         segments = np.stack([np.column_stack([x - r, rows]), np.column_stack([x + r, rows])], axis=1)
-        ax.add_collection(LineCollection(segments, colors=colours, linewidths=1.5))
-    ax.vlines(x, 0, 0.8, colors=colours, linewidths=0.8, rasterized=len(x) > 2000)
+        ax.add_collection(LineCollection(segments, colors=colours, linewidths=1.5))  # type: ignore[arg-type]
+    ax.vlines(x, 0, 0.8, colors=colours, linewidths=0.8, rasterized=len(x) > 2000)  # type: ignore[arg-type]
     ax.set_xlim(lo1, hi1)
     ax.set_ylim(-0.9, 1.0)
     ax.set_yticks([])
@@ -220,13 +236,13 @@ def _wrap(title: str, width: int) -> str:
     return "\n".join(textwrap.wrap(title, width)) if title else ""
 
 
-def points_figure(x: np.ndarray, r: Optional[np.ndarray], lo: np.ndarray, hi: np.ndarray,
+def points_figure(x: FloatArray, r: Optional[FloatArray], lo: FloatArray, hi: FloatArray,
                   title: str = "", *, zoom: Optional[bool] = None, disks: Optional[bool] = None,
-                  dpi: float = 150):
-    """The Figure of `vpds sample --plot`: the points coloured by r with a colour bar, their
-    disks for small n, a zoom panel on the densest place when the points cannot be told apart
-    (zoom=None: decide; False: never; True: whenever a window 4x smaller than the box holds the
-    smallest radii), a slice in 3D+, a strip in 1D."""
+                  dpi: float = 150) -> Figure:
+    """The Figure of `vpds sample --plot`: the points x (n, d) in the box lo, hi (d,), coloured
+    by r (n,) or None with a colour bar, their disks for small n, a zoom panel on the densest
+    place when the points cannot be told apart (zoom=None: decide; False: never; True: whenever
+    a window 4x smaller than the box holds the smallest radii), a slice in 3D+, a strip in 1D."""
     view = _View(x, r, lo, hi)
     norm = _norm(view.r_all, view.has_radii)
     if disks is None:
@@ -283,7 +299,7 @@ def points_figure(x: np.ndarray, r: Optional[np.ndarray], lo: np.ndarray, hi: np
     return fig
 
 
-def _indicate(ax, zax, zl, zh):
+def _indicate(ax: Axes, zax: Axes, zl: FloatArray, zh: FloatArray) -> None:
     """The zoom window's rectangle on ax, with lines to zax; a ring around it when it is tiny."""
     ax.indicate_inset(bounds=(zl[0], zl[1], zh[0] - zl[0], zh[1] - zl[1]), inset_ax=zax,
                       edgecolor="red", alpha=0.9, linewidth=1.2)
@@ -296,7 +312,7 @@ def _indicate(ax, zax, zl, zh):
         spine.set_linewidth(1.2)
 
 
-def _colour_bar(fig, axes, norm, view: _View):
+def _colour_bar(fig: Figure, axes: list[Axes], norm: Optional[Normalize], view: _View) -> Optional[Colorbar]:
     import matplotlib
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import LogNorm
@@ -316,7 +332,8 @@ def _colour_bar(fig, axes, norm, view: _View):
     return bar
 
 
-def _points_figure_1d(view: _View, norm, title, zoom, disks, dpi):
+def _points_figure_1d(view: _View, norm: Optional[Normalize], title: str, zoom: Optional[bool],
+                      disks: bool, dpi: float) -> Figure:
     lo1, hi1 = float(view.lo[0]), float(view.hi[0])
     pixels_per_unit = 11 * 0.85 * dpi / (hi1 - lo1)
     if zoom is None:
@@ -350,7 +367,7 @@ def _points_figure_1d(view: _View, norm, title, zoom, disks, dpi):
     return fig
 
 
-def plot_points(path: Path, x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np.ndarray,
+def plot_points(path: Path, x: FloatArray, r: Optional[FloatArray], lo: FloatArray, hi: FloatArray,
                 title: str, *, zoom: Optional[bool] = None, disks: Optional[bool] = None,
                 dpi: float = 150) -> None:
     """Write points_figure(...) as a PNG at path."""
@@ -361,7 +378,7 @@ def plot_points(path: Path, x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np
 # -- the analysis sheet ----------------------------------------------------------------------------
 
 
-def _padded_range(values: np.ndarray, at_least: tuple, pad: float = 0.08):
+def _padded_range(values: FloatArray, at_least: tuple[float, float], pad: float = 0.08) -> tuple[float, float]:
     v = values[np.isfinite(values)]
     lo_, hi_ = at_least
     if len(v):
@@ -370,11 +387,13 @@ def _padded_range(values: np.ndarray, at_least: tuple, pad: float = 0.08):
     return lo_ - pad * span, hi_ + pad * span
 
 
-def analysis_figure(x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np.ndarray, report, rule: str,
-                    lipschitz: float, scale: float, *, title: Optional[str] = None, dpi: float = 110):
-    """The Figure of `vpds analyze --plot`: the points (coloured by r), the periodogram (DC
-    removed), radial mean power, anisotropy, and in 2D the Delaunay minimum-angle and
-    edge-ratio histograms with the Table 1 bounds. Every range is set from the data."""
+def analysis_figure(x: FloatArray, r: FloatArray, lo: FloatArray, hi: FloatArray, report: Optional[DelaunayReport],
+                    rule: str, lipschitz: float, scale: float, *, title: Optional[str] = None,
+                    dpi: float = 110) -> Figure:
+    """The Figure of `vpds analyze --plot`: the points x (n, d) in the box lo, hi (d,), coloured
+    by r (n,), the periodogram (DC removed), radial mean power, anisotropy, and in 2D the
+    Delaunay minimum-angle and edge-ratio histograms with the Table 1 bounds. Every range is set
+    from the data."""
     from . import analysis
     lo = np.asarray(lo, dtype=float).reshape(-1)
     hi = np.asarray(hi, dtype=float).reshape(-1)
@@ -465,7 +484,7 @@ def analysis_figure(x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np.ndarray
     return fig
 
 
-def _analysis_figure_1d(view: _View, norm, title: str, dpi: float):
+def _analysis_figure_1d(view: _View, norm: Optional[Normalize], title: str, dpi: float) -> Figure:
     """1D: the strip, and the histogram of the gaps to the next point over r (no spectrum, no
     Delaunay: those are 2D)."""
     fig = _new_figure(figsize=(16, 4.2), dpi=dpi, layout="constrained")
@@ -490,9 +509,9 @@ def _analysis_figure_1d(view: _View, norm, title: str, dpi: float):
     return fig
 
 
-def plot_analysis(path: Path, x: np.ndarray, r: np.ndarray, lo: np.ndarray, hi: np.ndarray,
-                  report, rule: str, lipschitz: float, scale: float, *, title: Optional[str] = None,
-                  dpi: float = 110) -> None:
+def plot_analysis(path: Path, x: FloatArray, r: FloatArray, lo: FloatArray, hi: FloatArray,
+                  report: Optional[DelaunayReport], rule: str, lipschitz: float, scale: float, *,
+                  title: Optional[str] = None, dpi: float = 110) -> None:
     """Write analysis_figure(...) as a PNG at path."""
     fig = analysis_figure(x, r, lo, hi, report, rule, lipschitz, scale, title=title, dpi=dpi)
     fig.savefig(path, dpi=dpi)

@@ -1,12 +1,11 @@
 """A sizing given as radii at the nodes of a regular grid (libvpds's vpds_grid)."""
 from __future__ import annotations
 
-from typing import Sequence
-
 import numpy as np
 import numpy.typing as npt
 
 from ._errors import _raise, created
+from ._typing import BoundsLike
 from ._vpds import ffi, lib
 
 __all__ = ["SizingGrid"]
@@ -14,9 +13,10 @@ __all__ = ["SizingGrid"]
 
 class SizingGrid:
     """Radii at the nodes of a regular grid over [lo, hi] (C order, axis k along x[k]),
-    interpolated multilinearly. `lipschitz` is exact (the largest gradient norm)."""
+    interpolated multilinearly: `values` has one axis per dimension, lo and hi shape (d,).
+    `lipschitz` is exact (the largest gradient norm)."""
 
-    def __init__(self, values: npt.ArrayLike, lo: Sequence[float], hi: Sequence[float]):
+    def __init__(self, values: npt.ArrayLike, lo: BoundsLike, hi: BoundsLike) -> None:
         v = np.ascontiguousarray(values, dtype=np.float64)
         if v.ndim < 1 or v.ndim > 8:
             raise ValueError(f"grid values have {v.ndim} dimensions; expected 1 to 8")
@@ -38,10 +38,12 @@ class SizingGrid:
         return float(lib.vpds_grid_lipschitz(self._ptr))
 
     @property
-    def values(self) -> np.ndarray:
+    def values(self) -> npt.NDArray[np.float64]:
+        """The radii at the nodes (as enforce_lipschitz left them), of the grid's shape."""
         n = lib.vpds_grid_size(self._ptr)
         buf = ffi.buffer(lib.vpds_grid_values(self._ptr), n * 8)
-        return np.frombuffer(buf, dtype=np.float64).reshape(self._values.shape).copy()
+        v: npt.NDArray[np.float64] = np.frombuffer(buf, dtype=np.float64).reshape(self._values.shape).copy()
+        return v
 
     def enforce_lipschitz(self, lipschitz: float) -> "SizingGrid":
         """Lower values (only) until the interpolant is `lipschitz`-Lipschitz (every edge slope
@@ -51,7 +53,8 @@ class SizingGrid:
             _raise(st, f"lipschitz = {lipschitz!r}: must be finite and > 0")
         return self
 
-    def __call__(self, x: npt.ArrayLike) -> np.ndarray:
+    def __call__(self, x: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """r at points of shape (m, d) (or one point (d,)): shape (m,)."""
         pts = np.ascontiguousarray(np.atleast_2d(x), dtype=np.float64)
         return np.array([lib.vpds_grid_eval(self._ptr, ffi.cast("const double *", ffi.from_buffer(p)))
                          for p in pts])

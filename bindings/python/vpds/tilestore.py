@@ -14,9 +14,10 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Iterator, Optional, Union
+from typing import Any, Iterator, Literal, Mapping, Optional, Sequence, Union, cast
 
 import numpy as np
+import numpy.typing as npt
 
 __all__ = ["TileStore"]
 
@@ -27,20 +28,21 @@ _ROWS_PER_CHUNK = 1 << 20
 class TileStore:
     """Read and write the tiles of one run. `TileStore(path)` opens an existing store."""
 
-    def __init__(self, path: Union[str, Path], mode: str = "r"):
+    def __init__(self, path: Union[str, Path], mode: Literal["r", "r+", "a", "w", "w-"] = "r") -> None:
         import zarr
         self.path = str(path)
         self._root = zarr.open_group(self.path, mode=mode)
         info = self._root.attrs.get("vpds_tiling")
         if info is None:
             raise ValueError(f"{self.path}: not a vpds tile store (no vpds_tiling attribute)")
-        self.info = dict(info)
+        self.info: dict[str, Any] = dict(cast(Mapping[str, Any], info))  # a JSON object: create() writes it
         self.d = int(self.info["params"]["d"])
         self.count = int(self.info["count"])
         self.phases = list(self.info["phases"])
 
     @classmethod
-    def create(cls, path: Union[str, Path], params: dict, token: str, phases: list) -> "TileStore":
+    def create(cls, path: Union[str, Path], params: dict[str, Any], token: str,
+               phases: Sequence[int]) -> "TileStore":
         """A new store, or the existing one when it holds the same run (same token)."""
         import zarr
         p = Path(path)
@@ -59,9 +61,14 @@ class TileStore:
         return cls(path, mode="r+")
 
     # -- tiles -------------------------------------------------------------------------------------
-    def _group(self, tile: int):
+    def _node(self, key: str) -> Any:
+        """The group or array at `key`: zarr types it as either, the layout above says which."""
+        return self._root[key]
+
+    def _group(self, tile: int) -> Any:
+        """The tile's group, or None."""
         try:
-            return self._root[f"tiles/{int(tile)}"]
+            return self._node(f"tiles/{int(tile)}")
         except KeyError:
             return None
 
@@ -76,8 +83,10 @@ class TileStore:
     def missing(self) -> list[int]:
         return [k for k in range(self.count) if not self.complete(k)]
 
-    def write(self, tile: int, x: np.ndarray, r: np.ndarray, t: np.ndarray) -> None:
-        """The tile's arrays, then its completion mark (a reader never sees a partial tile)."""
+    def write(self, tile: int, x: npt.NDArray[np.float64], r: npt.NDArray[np.float64],
+              t: npt.NDArray[np.float64]) -> None:
+        """The tile's arrays (points (n, d), radius and t (n,)), then its completion mark (a reader
+        never sees a partial tile)."""
         g = self._root.require_group(f"tiles/{int(tile)}")
         n = len(x)
         for name, arr in (("points", np.ascontiguousarray(x, dtype=np.float64).reshape(n, self.d)),
@@ -89,18 +98,18 @@ class TileStore:
                 a[...] = arr
         g.attrs.update({"count": int(n), "phase": int(self.phases[int(tile)]), "complete": True})
 
-    def read(self, tile: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def read(self, tile: int) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]:
         """(points (n, d), radius (n,), t (n,)) of a complete tile."""
         if not self.complete(tile):
             raise KeyError(f"tile {tile} of {self.path} is not complete")
         g = self._group(tile)
         return g["points"][...], g["radius"][...], g["t"][...]
 
-    def read_points(self, tile: int) -> tuple[np.ndarray, np.ndarray]:
-        """(points, radius) of a complete tile: what a dependent tile's run needs."""
+    def read_points(self, tile: int) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """(points (n, d), radius (n,)) of a complete tile: what a dependent tile's run needs."""
         if not self.complete(tile):
             raise KeyError(f"tile {tile} of {self.path} is not complete")
-        return self._root[f"tiles/{int(tile)}/points"][...], self._root[f"tiles/{int(tile)}/radius"][...]
+        return self._node(f"tiles/{int(tile)}/points")[...], self._node(f"tiles/{int(tile)}/radius")[...]
 
     def tile_count(self, tile: int) -> int:
         return int(self._group(tile).attrs["count"])
@@ -110,10 +119,11 @@ class TileStore:
         """The run's insertion order of tiles: by phase, then index."""
         return sorted(range(self.count), key=lambda k: (self.phases[k], k))
 
-    def iter_tiles(self, order: str = "insertion") -> Iterator[tuple[int, np.ndarray, np.ndarray, np.ndarray]]:
-        """(tile, points, radius, t) one tile at a time: memory holds one tile, whatever the
-        total. order="insertion" (phase, then index: the order in which the union is
-        conflict-free under any rule) or "index"."""
+    def iter_tiles(self, order: str = "insertion"
+                   ) -> Iterator[tuple[int, npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]]:
+        """(tile, points (n, d), radius (n,), t (n,)) one tile at a time: memory holds one tile,
+        whatever the total. order="insertion" (phase, then index: the order in which the union
+        is conflict-free under any rule) or "index"."""
         tiles = self.order() if order == "insertion" else range(self.count)
         for k in tiles:
             x, r, t = self.read(k)
@@ -124,8 +134,10 @@ class TileStore:
         """Samples in the complete tiles."""
         return sum(self.tile_count(k) for k in range(self.count) if self.complete(k))
 
-    def to_numpy(self, order: str = "insertion") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Every sample at once (for runs that fit in memory)."""
+    def to_numpy(self, order: str = "insertion"
+                 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """Every sample at once, (points (n, d), radius (n,), t (n,)) (for runs that fit in
+        memory)."""
         parts = list(self.iter_tiles(order))
         if not parts:
             return np.empty((0, self.d)), np.empty(0), np.empty(0)
@@ -137,5 +149,5 @@ class TileStore:
         return f"TileStore({self.path!r}: {done}/{self.count} tiles complete, d = {self.d})"
 
     @property
-    def params(self) -> dict:
+    def params(self) -> dict[str, Any]:
         return dict(self.info["params"])

@@ -13,16 +13,20 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Optional, Sequence, Union
 
 import numpy as np
+import numpy.typing as npt
 
 from ._callbacks import raise_failure, take
-from ._core import RULES, SizingGrid, _seed_from
+from ._core import RULES, SizingGrid
 from ._errors import _raise, created
+from ._scipy_compat import _seed_from
+from ._typing import BoundsLike, RngLike, SizingFunction
 from ._vpds import ffi, lib
 from .gridsource import GridSource
 
 __all__ = ["TilingSpec", "Tiling"]
 
-SizingArg = Union[None, float, np.ndarray, SizingGrid, GridSource, Callable[[np.ndarray], np.ndarray]]
+#: what `sizing` takes (TilingSpec.make, distributed.sample): see TilingSpec
+SizingArg = Union[None, float, npt.NDArray[Any], SizingGrid, GridSource, SizingFunction]
 
 
 @dataclass
@@ -34,16 +38,16 @@ class TilingSpec:
     .npy, Zarr or OpenEXR), or a vectorised callable (then `lipschitz` and `radius_max`)."""
 
     d: int
-    tiles: tuple
-    l_bounds: tuple
-    u_bounds: tuple
+    tiles: tuple[int, ...]
+    l_bounds: tuple[float, ...]
+    u_bounds: tuple[float, ...]
     radius: float = 0.05
     sizing: SizingArg = None
     lipschitz: Optional[float] = None
     rule: str = "smaller"
     inhibition: float = 1.0
     coverage: float = 1.0
-    periodic: Optional[tuple] = None
+    periodic: Optional[tuple[bool, ...]] = None
     weighted: bool = False
     radius_min: Optional[float] = None
     radius_max: Optional[float] = None
@@ -52,13 +56,13 @@ class TilingSpec:
     _token: str = field(default="", repr=False)
 
     @classmethod
-    def make(cls, d: int, tiles: Sequence[int], *, l_bounds: Optional[Sequence[float]] = None,
-             u_bounds: Optional[Sequence[float]] = None, radius: float = 0.05,
+    def make(cls, d: int, tiles: Sequence[int], *, l_bounds: Optional[BoundsLike] = None,
+             u_bounds: Optional[BoundsLike] = None, radius: float = 0.05,
              sizing: SizingArg = None, lipschitz: Optional[float] = None, rule: str = "smaller",
              inhibition: float = 1.0, coverage: float = 1.0,
              periodic: Optional[Sequence[bool]] = None, weighted: bool = False,
              radius_min: Optional[float] = None, radius_max: Optional[float] = None,
-             rng: Any = 0, scale: float = 1.0) -> "TilingSpec":
+             rng: RngLike = 0, scale: float = 1.0) -> "TilingSpec":
         """Checked arguments (the C library checks the rest, with its messages)."""
         if not isinstance(d, (numbers.Integral, np.integer)) or isinstance(d, bool):
             raise TypeError(f"d = {d!r}: must be an int")
@@ -117,7 +121,7 @@ class TilingSpec:
     def token(self) -> str:
         return self._token
 
-    def describe(self) -> dict:
+    def describe(self) -> dict[str, Any]:
         """The parameters as plain values (for the store's attributes)."""
         s = self.sizing
         kind = ("radius" if s is None else "grid" if isinstance(s, np.ndarray) else
@@ -134,7 +138,7 @@ class _CallbackOwner:
     """What vpds_py_sizing_batch needs: d, the callable, and a slot for its exception (see
     vpds._callbacks)."""
 
-    def __init__(self, d: int, fn: Callable[[np.ndarray], np.ndarray]):
+    def __init__(self, d: int, fn: SizingFunction) -> None:
         self.d = d
         self._sizing_fn = fn
         self._callback_error: Optional[BaseException] = None
@@ -143,10 +147,10 @@ class _CallbackOwner:
 class Tiling:
     """The C vpds_tiling of a spec, and the run of one tile."""
 
-    def __init__(self, spec: TilingSpec):
+    def __init__(self, spec: TilingSpec) -> None:
         self.spec = spec
         d = spec.d
-        self._keep: list = []
+        self._keep: list[Any] = []
         desc = ffi.new("vpds_desc *", lib.vpds_default_desc())
         desc.dim = d
         lo = ffi.new("double[]", list(spec.l_bounds))
@@ -212,13 +216,14 @@ class Tiling:
     def seed(self, tile: int) -> int:
         return int(lib.vpds_tiling_seed(self._t, self._check_tile(tile)))
 
-    def box(self, tile: int) -> tuple[np.ndarray, np.ndarray]:
+    def box(self, tile: int) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """(lo, hi) of the tile's core, each of shape (d,)."""
         lo = ffi.new("double[]", self.spec.d)
         hi = ffi.new("double[]", self.spec.d)
         lib.vpds_tiling_box(self._t, self._check_tile(tile), lo, hi)
         return np.array(list(lo)), np.array(list(hi))
 
-    def coords(self, tile: int) -> tuple:
+    def coords(self, tile: int) -> tuple[int, ...]:
         c = ffi.new("uint64_t[]", self.spec.d)
         lib.vpds_tiling_coords(self._t, self._check_tile(tile), c)
         return tuple(int(v) for v in c)
@@ -258,7 +263,8 @@ class Tiling:
         """Node offsets and counts of the grid window that covers this tile's core (with one
         node to spare on each side)."""
         src = self.spec.sizing
-        shape = src.shape if isinstance(src, GridSource) else np.shape(src)
+        # the nodes of a grid; the other sizings have none: (), as np.shape gives for them
+        shape = src.shape if isinstance(src, (GridSource, np.ndarray)) else ()
         lo, hi = self.box(tile)
         off, cnt = [], []
         for k in range(self.spec.d):
@@ -270,8 +276,8 @@ class Tiling:
         return off, cnt
 
     # -- one tile's run ------------------------------------------------------------------------
-    def run_tile(self, tile: int, deps: Mapping[int, tuple[np.ndarray, np.ndarray]],
-                 budget: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def run_tile(self, tile: int, deps: Mapping[int, tuple[npt.ArrayLike, npt.ArrayLike]],
+                 budget: int = 0) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]:
         """The tile's own samples (points (n, d), radii (n,), scales (n,)) from its
         dependencies' samples: deps[k] = (points, radii) of tile k, for every k in deps(tile)."""
         tile = self._check_tile(tile)
@@ -288,7 +294,7 @@ class Tiling:
             pts[i].n = len(x)
         window = ffi.NULL
         if isinstance(self.spec.sizing, GridSource):
-            window = self._window(tile)
+            window = self._window(tile, self.spec.sizing)
             keep.append(window)
         out = ffi.new("vpds_sampler **")
         nfix = ffi.new("size_t *")
@@ -314,8 +320,8 @@ class Tiling:
         t = np.frombuffer(ffi.buffer(lib.vpds_scales(s), n * 8), dtype=np.float64)[f:].copy()
         return x, r, t
 
-    def _window(self, tile: int):
-        src: GridSource = self.spec.sizing  # type: ignore[assignment]
+    def _window(self, tile: int, src: GridSource) -> Any:
+        """The C grid of src's window over this tile (run_tile's, with a GridSource sizing)."""
         off, cnt = self.window_range(tile)
         values = np.ascontiguousarray(src.window(off, [o + c for o, c in zip(off, cnt)]), dtype=np.float64)
         return src.make_window(values, off)
