@@ -12,22 +12,27 @@
 #   CORPUS   "grow": new inputs go to OUT/corpus_<harness> and stay for the next run;
 #            "fresh": they go to a directory emptied first, so that a run starts from the
 #            seeds alone and takes the same time every time (make check-fuzz)
+# FUZZ_JOBS harnesses run side by side (default: the cores); their reports print in order.
 # FUZZ_SLOW=report (make check-fuzz): an input slower than TIMEOUT is shown and kept, but does
 # not fail the run: the known slow coverage search of two radii and thin domains (issue 13's
 # open item) is found within seconds. Crashes, leaks, broken invariants and OOM still fail.
 set -u
 slow_mode=${FUZZ_SLOW:-fail}
+jobs=${FUZZ_JOBS:-$(nproc 2>/dev/null || echo 1)}
 out=$1 seconds=$2 timeout=$3 rss=$4 seeds=$5 corpus=$6
 shift 6
 # one input may run up to TIMEOUT past the budget, and the seeds run before it starts
 wall=$((seconds + 2 * timeout + 60))
 mkdir -p "$out/artifacts"
-failed=()
-for f in "$@"; do
-  bin=$out/fuzz_$f log=$out/fuzz_$f.log dir=$out/corpus_$f
+
+# One harness: its one-line summary (and on failure libFuzzer's report) into
+# OUT/fuzz_F.report; OUT/fuzz_F.failed exists when it failed.
+fuzz_one() {
+  local f=$1 bin=$out/fuzz_$1 log=$out/fuzz_$1.log dir=$out/corpus_$1 report=$out/fuzz_$1.report
+  local seed=() start rc took runs rate slow summary why
+  rm -f "$out/fuzz_$f.failed"
   [ "$corpus" = fresh ] && dir=$out/check_corpus_$f && rm -rf "$dir"
   mkdir -p "$dir"
-  seed=()
   [ -d "$seeds/$f" ] && seed=("$seeds/$f")
   start=$(date +%s)
   # allocator_may_return_null: the harnesses test the library's out-of-memory paths
@@ -42,27 +47,42 @@ for f in "$@"; do
   summary=$(printf 'fuzz_%-9s %9s runs in %3d s, %6s exec/s' "$f" "${runs:-?}" "$took" "${rate:-?}")
   [ "${slow:-0}" -gt 0 ] 2> /dev/null && summary="$summary, slowest input $slow s"
   if [ $rc = 0 ] && [ -n "$runs" ]; then
-    echo "$summary: OK"
-    continue
+    echo "$summary: OK" > "$report"
+    return
   fi
   if [ "$slow_mode" = report ] && grep -q 'ERROR: libFuzzer: timeout' "$log" &&
      ! grep -qE 'ERROR: (AddressSanitizer|LeakSanitizer)|invariant broken|runtime error' "$log"; then
-    echo "$summary: SLOW (an input over $timeout s, not failed here; $(sed -n 's/.*Test unit written to //p' "$log"))"
-    continue
+    echo "$summary: SLOW (an input over $timeout s, not failed here; $(sed -n 's/.*Test unit written to //p' "$log"))" > "$report"
+    return
   fi
-  failed+=("fuzz_$f")
+  touch "$out/fuzz_$f.failed"
   case $rc in
     124 | 137) why="did not stop within $wall s" ;;
     0) why="no statistics in the log" ;;
     *) why="exit status $rc" ;;
   esac
-  echo "$summary: FAIL ($why; full log $log)"
-  # the report: from the first error line on (sanitizer, libFuzzer, harness invariant), without
-  # the frames of libFuzzer's own loop and of the C runtime
-  awk '/ERROR|invariant broken|runtime error/ { on = 1 } on' "$log" |
-    grep -Ev ' in (fuzzer::|__sanitizer_print_stack_trace|__libc_start|_start |main )' |
-    head -n 40 | sed 's/^/    /'
-  sed -n 's/.*Test unit written to \(.*\)/    artifact: \1/p' "$log"
+  {
+    echo "$summary: FAIL ($why; full log $log)"
+    # the report: from the first error line on (sanitizer, libFuzzer, harness invariant),
+    # without the frames of libFuzzer's own loop and of the C runtime
+    awk '/ERROR|invariant broken|runtime error/ { on = 1 } on' "$log" |
+      grep -Ev ' in (fuzzer::|__sanitizer_print_stack_trace|__libc_start|_start |main )' |
+      head -n 40 | sed 's/^/    /'
+    sed -n 's/.*Test unit written to \(.*\)/    artifact: \1/p' "$log"
+  } > "$report"
+}
+
+running=0
+for f in "$@"; do
+  fuzz_one "$f" &
+  running=$((running + 1))
+  if [ "$running" -ge "$jobs" ]; then wait -n; running=$((running - 1)); fi
+done
+wait
+failed=()
+for f in "$@"; do
+  if [ -f "$out/fuzz_$f.report" ]; then cat "$out/fuzz_$f.report"; else echo "fuzz_$f: FAIL (no report)"; failed+=("fuzz_$f"); fi
+  [ -f "$out/fuzz_$f.failed" ] && failed+=("fuzz_$f")
 done
 if [ ${#failed[@]} -gt 0 ]; then
   echo "fuzz: FAILED: ${failed[*]} (replay an artifact with $out/fuzz_<harness> ARTIFACT)"

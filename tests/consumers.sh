@@ -12,12 +12,7 @@ rm -rf "$out"
 mkdir -p "$out"
 quick=$BUILD/readme/quick.c
 [ -s "$quick" ] || { echo "consumers: $quick missing (tests/readme_quickstart.sh writes it)" >&2; exit 1; }
-configs=(
-  "2 smaller const 0.02 1 0 1"
-  "3 prior ramp 0 3 0.02 0.32"
-  "3 bigger steep 0 7 0 0.7 inhibition=0.5 periodic=6"
-  "2 smaller const 0.03 8 0 1 inhibition=0.5 domain=ball"
-)
+mapfile -t configs < <(grep -v '^#' tests/golden/configs.txt)
 log=$out/log
 run() { "$@" >> "$log" 2>&1 || { echo "consumers: failed: $*" >&2; tail -30 "$log" >&2; exit 1; }; }
 

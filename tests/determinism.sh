@@ -8,20 +8,7 @@ set -euo pipefail
 out=${1:-build/determinism}
 mkdir -p "$out"
 current=$(sed -n 's/^#define VPDS_ALGORITHM_VERSION \([0-9]*\).*/\1/p' include/vpds.h)
-configs=(
-  "2 smaller const 0.02 1 0 1"
-  "1 bigger ramp 0 2 0 1"
-  "3 prior ramp 0 3 0.02 0.32"
-  "2 current radial 0 4 0.5 0.6"
-  "4 smaller const 0.2 5 0 1"
-  "2 smaller mild 0 6 0 1 0 1"
-  # two radii, a domain, periodic axes: the coverage search that version 2 changed
-  "3 bigger steep 0 7 0 0.7 inhibition=0.5 periodic=6"
-  "2 smaller const 0.03 8 0 1 inhibition=0.5 domain=ball"
-  "2 current mild 0 9 0 1 inhibition=0.6"
-  "3 smaller const 0.12 10 0 1 domain=ball"
-  "2 prior steep 0 11 0 1 0 0 inhibition=0.4 periodic=2 domain=ball"
-)
+mapfile -t configs < <(grep -v '^#' tests/golden/configs.txt)
 variants=("gcc -O0" "gcc -O3" "clang -O0" "clang -O3" "gcc -O1 -fsanitize=address,undefined")
 # the library's own flags: no FMA contraction, no fast-math
 common="-std=c99 -ffp-contract=off -Iinclude"

@@ -269,8 +269,11 @@ def test_sigint_during_a_python_sizing_raises_keyboardinterrupt(tmp_path, sizing
     (before: "Exception ignored from cffi callback" and a garbage radius, 3 runs of 3)."""
     script = tmp_path / "child.py"
     script.write_text(CHILD)
+    # SIG_DFL in the child: a suite started in the background (SIGINT ignored, inherited)
+    # would otherwise give a child that Python leaves without its Ctrl-C handler
     proc = subprocess.Popen([sys.executable, str(script), sizing], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+                            stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         assert proc.stdout.readline().strip() == "started"
         time.sleep(0.5)

@@ -218,9 +218,11 @@ def test_ctrl_c_exits_130_and_keeps_the_samples(tmp_path):
     import signal
     import time
     out = tmp_path / "big.npz"
+    # SIG_DFL in the child, whatever the suite inherited (a background job ignores SIGINT)
     proc = subprocess.Popen([sys.executable, "-m", "vpds", "sample", "--radius", "0.0002",
                              "-o", str(out), "--no-progress"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+                            stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     time.sleep(3)
     proc.send_signal(signal.SIGINT)
     stdout, stderr = proc.communicate(timeout=60)
