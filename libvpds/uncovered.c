@@ -235,7 +235,7 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
     r_lo = q->rp - q->L * diag;
     r_hi = q->rp + q->L * diag;
     if (q->point) {
-        double f = q->scale * vpdsi_rule_f(s->rule, q->r_anchor, q->rp), d2 = 0, f_hi;
+        double f = q->scale * vpdsi_rule_f(s->rule, q->r_anchor, q->rp), d2 = 0;
         for (k = 0; k < d; k++) d2 += (p[k] - q->alo[k]) * (p[k] - q->alo[k]);
         in_region = d2 <= f * f;
         /* Version 2: the box's nearest point lies beyond f(r_anchor, r) for every r the box
@@ -243,8 +243,10 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
          * it straddled a coverage boundary, down to the depth limit and a false "uncovered":
          * a dart accepted that covers nothing new: 90 of the 677 samples of a 3D run with
          * two radii and the bigger rule (tests/determinism.sh, configuration 7). */
-        f_hi = q->scale * vpdsi_rule_f(s->rule, q->r_anchor, r_hi);
-        if (q->exact_region && d2 > f_hi * f_hi) return VPDS_OK;
+        if (q->exact_region) {
+            double f_hi = q->scale * vpdsi_rule_f(s->rule, q->r_anchor, r_hi);
+            if (d2 > f_hi * f_hi) return VPDS_OK;
+        }
     } else {
         double d2 = 0;
         for (k = 0; k < d; k++) {
