@@ -123,3 +123,22 @@ size_t vpdsi_bgrid_near(const vpdsi_bgrid *g, uint64_t at, int32_t *out)
     }
     return found;
 }
+
+int32_t vpdsi_bgrid_conflict(const vpdsi_bgrid *g, const double *x, const double *y, double reach)
+{
+    const int32_t *cell = g->cell + vpdsi_bgrid_locate(g, y);
+    double reach2 = reach * reach;
+    size_t j;
+    int k, d = g->dim;
+    if (cell[0] >= 0) return cell[0]; /* a cell holds one sample: any other point conflicts */
+    for (j = 0; j < g->n_stencil; j++) {
+        int32_t i = cell[g->stencil[j]];
+        if (i >= 0) {
+            const double *xi = x + (size_t)i * (size_t)d;
+            double d2 = 0;
+            for (k = 0; k < d; k++) d2 += (y[k] - xi[k]) * (y[k] - xi[k]);
+            if (d2 < reach2) return i;
+        }
+    }
+    return -1;
+}

@@ -30,4 +30,6 @@ uint64_t vpdsi_bgrid_index(const vpdsi_bgrid *g, const uint64_t *c);
 /* Samples within reach of the cell at padded index at (its own first), appended to out
  * (capacity >= 1 + n_stencil). */
 size_t vpdsi_bgrid_near(const vpdsi_bgrid *g, uint64_t at, int32_t *out);
+/* The first sample within reach of y (strictly nearer), or -1; x holds the samples' points. */
+int32_t vpdsi_bgrid_conflict(const vpdsi_bgrid *g, const double *x, const double *y, double reach);
 #endif

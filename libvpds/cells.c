@@ -1,5 +1,21 @@
 #include "cells.h"
+#include <math.h>
 #include <string.h>
+
+double vpdsi_lattice_box(const vpdsi_lattice *g, unsigned level, const uint64_t *c, double *lo,
+                         double *hi)
+{
+    double diag2 = 0;
+    int k;
+    for (k = 0; k < g->dim; k++) {
+        double side = ldexp(g->side0[k], -(int)level);
+        uint64_t last = (g->n0[k] << level) - 1;
+        lo[k] = g->lo[k] + (double)c[k] * side;
+        hi[k] = c[k] == last ? g->hi[k] : g->lo[k] + (double)(c[k] + 1) * side;
+        diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    }
+    return diag2;
+}
 
 unsigned vpdsi_bit_length(uint64_t n)
 {

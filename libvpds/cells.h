@@ -22,6 +22,20 @@ void vpdsi_cells_push(vpdsi_cells *c, int dim, const uint64_t *coord);
 void vpdsi_cells_get(const vpdsi_cells *c, size_t i, int dim, uint64_t *coord);
 /* Copy cell `from` over cell `to` (in-place compaction, to <= from). */
 void vpdsi_cells_move(vpdsi_cells *c, size_t from, size_t to);
+/* The geometry of the cells: a base grid of n0[k] cells of side side0[k] per axis over the box
+ * [lo, hi], halved per level. Shared by Algorithm 1's cells and the stream's regions. */
+typedef struct vpdsi_lattice {
+    int dim;
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
+    uint64_t n0[VPDS_MAX_DIM];
+    double side0[VPDS_MAX_DIM];
+} vpdsi_lattice;
+
+/* Box of the cell at `level` with integer coordinates c (the last cell of an axis ends exactly
+ * at the box's face); returns the squared diagonal. */
+double vpdsi_lattice_box(const vpdsi_lattice *g, unsigned level, const uint64_t *c, double *lo,
+                         double *hi);
+
 /* Bits needed to hold values below n (at least 1). */
 unsigned vpdsi_bit_length(uint64_t n);
 #endif

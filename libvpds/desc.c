@@ -1,7 +1,9 @@
 /* The sampler's descriptor: defaults, and the validation that explains every refusal. */
-#include "sampler.h"
+#include "desc.h"
+#include "grid.h"
 #include "refuse.h"
 #include "rules.h"
+#include "sizing.h"
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -110,11 +112,11 @@ vpds_status vpds_validate(const vpds_desc *d, char *msg, size_t cap)
             VPDSI_REFUSE(VPDS_ERR_OVERFLOW, "desc.radius = %g: must be within [1e-100, 1e100] (squared "
                    "distances overflow or underflow beyond)", d->radius);
     }
-    limit = vpdsi_rule_max_lipschitz(d->rule);
+    limit = vpdsi_rule_max_lipschitz(vpdsi_rule_resolve(d->rule));
     if (d->coverage * L >= limit)
         VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.lipschitz: coverage * L = %g * %g = %g is at or above "
                "the %s rule's limit %g (Table 1)", d->coverage, L, d->coverage * L,
-               vpdsi_rule_name(d->rule == VPDS_RULE_DEFAULT ? VPDS_RULE_SMALLER : d->rule), limit);
+               vpdsi_rule_name(vpdsi_rule_resolve(d->rule)), limit);
     if (d->periodic && !callback && !d->sizing_grid) {
         for (k = 0; k < d->dim; k++) {
             double side = (d->hi ? d->hi[k] : 1.0) - (d->lo ? d->lo[k] : 0.0);

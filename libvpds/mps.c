@@ -6,10 +6,9 @@
  * active cells always contain every uncovered point, so accepted darts are uniform over the free
  * region. Work is cut into chunks; between chunks the state is complete, so a pause, an error
  * or an exhausted budget can resume to exactly the points of an uninterrupted run. */
-#include "sampler.h"
+#include "mps.h"
 #include "rules.h"
 #include "torus.h"
-#include "uncovered.h"
 #include <math.h>
 #include <string.h>
 
@@ -19,22 +18,49 @@
 #define CHUNK 256           /* darts or cells between checks of the budget */
 #define PRECISION_BITS 44   /* cells stop splitting at 2^-44 of the coordinates' magnitude */
 
-void vpdsi_mps_reset(vpds_sampler *s, double t)
+void vpdsi_mps_init(vpdsi_mps *m, int dim, const double *period)
 {
-    s->run.phase = VPDSI_IDLE;
-    s->run.t = t;
-    s->stats.t = t;
+    memset(m, 0, sizeof *m);
+    vpdsi_uncovered_init(&m->unc, dim, period);
+    vpdsi_mps_reset(m, 1.0);
 }
 
-void vpdsi_mps_release(vpds_sampler *s)
+void vpdsi_mps_reset(vpdsi_mps *m, double t)
 {
-    vpdsi_cells_release(&s->run.cur, &s->mem);
-    vpdsi_cells_release(&s->run.next, &s->mem);
-    if (s->grid_mode) {
+    m->run.phase = VPDSI_IDLE;
+    m->run.t = t;
+}
+
+void vpdsi_mps_release_cells(vpdsi_mps *m, vpdsi_store *st)
+{
+    vpdsi_cells_release(&m->run.cur, st->mem);
+    vpdsi_cells_release(&m->run.next, st->mem);
+    if (st->grid_mode) {
         /* done at this scale: keep the samples, drop the accelerator (rebuilt on the next run) */
-        vpdsi_bgrid_release(&s->grid, &s->mem);
-        s->grid_mode = 0;
+        vpdsi_bgrid_release(&st->grid, st->mem);
+        st->grid_mode = 0;
     }
+}
+
+void vpdsi_mps_release(vpdsi_mps *m, vpdsi_store *st)
+{
+    vpdsi_mps_release_cells(m, st);
+    vpdsi_mem_free(st->mem, m->cand, m->cap_cand * sizeof(int32_t));
+    vpdsi_mem_free(st->mem, m->buf_x, m->cap_buf_x * sizeof(double));
+    vpdsi_mem_free(st->mem, m->buf_r, m->cap_buf_r * sizeof(double));
+    vpdsi_mem_free(st->mem, m->buf_u, m->cap_buf_u * sizeof(double));
+    vpdsi_uncovered_release(&m->unc, st->mem);
+    m->cand = NULL;
+    m->buf_x = m->buf_r = m->buf_u = NULL;
+    m->cap_cand = m->cap_buf_x = m->cap_buf_r = m->cap_buf_u = 0;
+}
+
+/* Upper bound of the distance at which a sample of r <= r_hi covers at the run's scale. */
+static double coverage_reach(const vpdsi_mps *m, const vpdsi_ctx *ctx, double r_hi)
+{
+    const vpdsi_problem *pb = ctx->pb;
+    return vpdsi_rule_reach(pb->rule, m->run.t * pb->coverage,
+                            ctx->st->sizing.lipschitz, r_hi);
 }
 
 #ifndef DARTS_PER_BASE_CELL
@@ -48,135 +74,127 @@ static uint64_t darts_for(uint64_t cells, unsigned level)
 
 /* The background grid serves a uniform radius in low dimension; the kd-tree everything else.
  * (vpdsi_bgrid_setup releases the grid of an earlier scale; the kd-tree path releases it below.) */
-static vpds_status choose_index(vpds_sampler *s)
+static vpds_status choose_index(vpdsi_mps *m, const vpdsi_ctx *ctx, int keep_tree)
 {
-    vpdsi_run *run = &s->run;
-    double reach = run->t * s->inhibition * s->sizing.radius;
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_store *st = ctx->st;
+    vpdsi_run *run = &m->run;
+    double reach = run->t * pb->inhibition * st->sizing.radius;
     size_t i;
-    s->grid_mode = 0;
-    if (s->sizing.kind == VPDSI_SIZING_CONSTANT && s->n_fixed == 0 && s->dim <= 3 &&
-        !s->two_radii && !s->any_periodic && !s->stream.active &&
-        vpdsi_bgrid_setup(&s->grid, &s->mem, s->dim, run->n0, s->lo, run->side0, reach) == 0 &&
-        vpdsi_mem_reserve(&s->mem, (void **)&s->cand, &s->cap_cand, s->grid.n_stencil + 1,
+    st->grid_mode = 0;
+    if (st->sizing.kind == VPDSI_SIZING_CONSTANT && st->n_fixed == 0 && pb->dim <= 3 &&
+        !pb->two_radii && !pb->any_periodic && !keep_tree &&
+        vpdsi_bgrid_setup(&st->grid, ctx->mem, pb->dim, run->geom.n0, pb->lo, run->geom.side0, reach) == 0 &&
+        vpdsi_mem_reserve(ctx->mem, (void **)&m->cand, &m->cap_cand, st->grid.n_stencil + 1,
                           sizeof(int32_t)) == 0) {
-        s->grid_mode = 1;
-        for (i = 0; i < s->n; i++) s->grid.cell[vpdsi_bgrid_locate(&s->grid, s->x + i * (size_t)s->dim)] = (int32_t)i;
+        st->grid_mode = 1;
+        for (i = 0; i < st->n; i++) st->grid.cell[vpdsi_bgrid_locate(&st->grid, st->x + i * (size_t)pb->dim)] = (int32_t)i;
         return VPDS_OK;
     }
-    vpdsi_bgrid_release(&s->grid, &s->mem);
-    return vpdsi_sync_tree(s);
+    vpdsi_bgrid_release(&st->grid, ctx->mem);
+    return vpdsi_store_sync_tree(st);
 }
 
 /* Base grid for the current scale: cells of diagonal t*coverage*r_max, so that in the uniform
  * case a sample covers its whole cell. */
-static vpds_status setup(vpds_sampler *s)
+static vpds_status setup(vpdsi_mps *m, const vpdsi_ctx *ctx, int keep_tree)
 {
-    vpdsi_run *run = &s->run;
-    vpds_status st;
-    int d = s->dim, k;
-    double target = run->t * s->coverage * s->sizing.rmax / sqrt((double)d) * (1 - 1e-9);
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_store *st = ctx->st;
+    vpdsi_run *run = &m->run;
+    vpds_status e;
+    int d = pb->dim, k;
+    double target = run->t * pb->coverage * st->sizing.rmax / sqrt((double)d) * (1 - 1e-9);
     uint64_t total = 1;
     unsigned max_level = 62;
+    run->geom.dim = d;
+    memcpy(run->geom.lo, pb->lo, sizeof run->geom.lo);
+    memcpy(run->geom.hi, pb->hi, sizeof run->geom.hi);
     for (k = 0; k < d; k++) {
-        double ext = s->hi[k] - s->lo[k], cells = ceil(ext / target), mag, min_side;
-        if (s->period[k] > 0 && !(ext > 2 * run->t * s->coverage * s->sizing.rmax)) {
+        double ext = pb->hi[k] - pb->lo[k], cells = ceil(ext / target), mag, min_side;
+        if (pb->period[k] > 0 && !(ext > 2 * run->t * pb->coverage * st->sizing.rmax)) {
             /* a disk would meet its own image across the wrap */
-            vpdsi_set_error(s, "periodic axis %d: side %g is not above 2 * t * coverage * r_max ="
-                            " %g (t = %g)", k, ext, 2 * run->t * s->coverage * s->sizing.rmax,
+            vpdsi_store_error(st, "periodic axis %d: side %g is not above 2 * t * coverage * r_max ="
+                            " %g (t = %g)", k, ext, 2 * run->t * pb->coverage * st->sizing.rmax,
                             run->t);
             return VPDS_ERR_INVALID_ARGUMENT;
         }
         unsigned lev;
         if (!(cells <= 1099511627776.0)) { /* 2^40 per axis */
-            vpdsi_set_error(s, "scale t = %g: axis %d of extent %g needs %g base cells of side %g;"
+            vpdsi_store_error(st, "scale t = %g: axis %d of extent %g needs %g base cells of side %g;"
                             " the cell count overflows", run->t, k, ext, cells, target);
             return VPDS_ERR_OVERFLOW;
         }
-        run->n0[k] = cells < 1 ? 1 : (uint64_t)cells;
-        run->side0[k] = ext / (double)run->n0[k];
-        if (total > (UINT64_C(1) << 40) / run->n0[k]) {
+        run->geom.n0[k] = cells < 1 ? 1 : (uint64_t)cells;
+        run->geom.side0[k] = ext / (double)run->geom.n0[k];
+        if (total > (UINT64_C(1) << 40) / run->geom.n0[k]) {
             /* no machine holds a sampling that fine: refuse rather than exhaust memory */
-            vpdsi_set_error(s, "scale t = %g: the base grid has more than 2^40 cells (radius too"
+            vpdsi_store_error(st, "scale t = %g: the base grid has more than 2^40 cells (radius too"
                             " small for the box); the cell count overflows", run->t);
             return VPDS_ERR_OVERFLOW;
         }
-        total *= run->n0[k];
-        mag = fabs(s->lo[k]) > fabs(s->hi[k]) ? fabs(s->lo[k]) : fabs(s->hi[k]);
+        total *= run->geom.n0[k];
+        mag = fabs(pb->lo[k]) > fabs(pb->hi[k]) ? fabs(pb->lo[k]) : fabs(pb->hi[k]);
         if (ext > mag) mag = ext;
         min_side = ldexp(mag, -PRECISION_BITS);
         lev = 0;
-        while (lev < 62 && ldexp(run->side0[k], -(int)(lev + 1)) >= min_side) lev++;
-        if (lev + vpdsi_bit_length(run->n0[k]) > 63) lev = 63 - vpdsi_bit_length(run->n0[k]);
+        while (lev < 62 && ldexp(run->geom.side0[k], -(int)(lev + 1)) >= min_side) lev++;
+        if (lev + vpdsi_bit_length(run->geom.n0[k]) > 63) lev = 63 - vpdsi_bit_length(run->geom.n0[k]);
         if (lev < max_level) max_level = lev;
     }
     run->base_count = total;
     run->max_level = max_level;
-    s->u_ready = 0;
-    if ((st = choose_index(s)) != VPDS_OK) return st;
+    m->unc.ready = 0;
+    if ((e = choose_index(m, ctx, keep_tree)) != VPDS_OK) return e;
     run->implicit = 1;
     run->pos = 0;
-    vpdsi_cells_layout(&run->cur, d, run->n0, 0);
-    vpdsi_cells_layout(&run->next, d, run->n0, 0);
-    if (s->n > 0) {
+    vpdsi_cells_layout(&run->cur, d, run->geom.n0, 0);
+    vpdsi_cells_layout(&run->next, d, run->geom.n0, 0);
+    if (st->n > 0) {
         run->phase = VPDSI_FILTER;
     } else {
         run->phase = VPDSI_DARTS;
         run->darts_left = darts_for(total, 0);
     }
-    if (total > s->stats.peak_active_cells) s->stats.peak_active_cells = total;
-    if (s->stats.levels < 1) s->stats.levels = 1;
+    if (total > ctx->stats->peak_active_cells) ctx->stats->peak_active_cells = total;
+    if (ctx->stats->levels < 1) ctx->stats->levels = 1;
     return VPDS_OK;
 }
 
-static void cell_coords(const vpds_sampler *s, uint64_t idx, uint64_t *c)
+static void cell_coords(const vpdsi_mps *m, const vpdsi_ctx *ctx, uint64_t idx, uint64_t *c)
 {
-    const vpdsi_run *run = &s->run;
+    const vpdsi_problem *pb = ctx->pb;
+    const vpdsi_run *run = &m->run;
     int k;
     if (run->implicit) {
-        for (k = 0; k < s->dim; k++) {
-            c[k] = idx % run->n0[k];
-            idx /= run->n0[k];
+        for (k = 0; k < pb->dim; k++) {
+            c[k] = idx % run->geom.n0[k];
+            idx /= run->geom.n0[k];
         }
     } else {
-        vpdsi_cells_get(&run->cur, (size_t)idx, s->dim, c);
+        vpdsi_cells_get(&run->cur, (size_t)idx, pb->dim, c);
     }
 }
 
-double vpdsi_cell_box(const vpds_sampler *s, unsigned level, const uint64_t *c, double *lo,
-                      double *hi)
-{
-    const vpdsi_run *run = &s->run;
-    double diag2 = 0;
-    int k;
-    for (k = 0; k < s->dim; k++) {
-        double side = ldexp(run->side0[k], -(int)level);
-        uint64_t last = (run->n0[k] << level) - 1;
-        lo[k] = s->lo[k] + (double)c[k] * side;
-        hi[k] = c[k] == last ? s->hi[k] : s->lo[k] + (double)(c[k] + 1) * side;
-        diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-    }
-    return diag2;
-}
+static unsigned cur_level(const vpdsi_mps *m) { return m->run.implicit ? 0 : m->run.cur.level; }
 
-static unsigned cur_level(const vpds_sampler *s) { return s->run.implicit ? 0 : s->run.cur.level; }
-
-static uint64_t cur_count(const vpds_sampler *s)
+static uint64_t cur_count(const vpdsi_mps *m)
 {
-    return s->run.implicit ? s->run.base_count : (uint64_t)s->run.cur.count;
+    return m->run.implicit ? m->run.base_count : (uint64_t)m->run.cur.count;
 }
 
 /* n darts into out (n*dim): a cell uniformly, then a point uniformly in it; in weighted mode
  * one more uniform per dart into u, for its acceptance (Eq. 12). */
-static void draw_darts(const vpds_sampler *s, vpdsi_rng *rng, size_t n, double *out, double *u)
+static void draw_darts(const vpdsi_mps *m, const vpdsi_ctx *ctx, vpdsi_rng *rng, size_t n, double *out, double *u)
 {
-    uint64_t c[VPDS_MAX_DIM], total = cur_count(s);
+    uint64_t c[VPDS_MAX_DIM], total = cur_count(m);
     double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
-    unsigned level = cur_level(s);
+    unsigned level = cur_level(m);
     size_t j;
-    int k, d = s->dim;
+    int k, d = ctx->pb->dim;
     for (j = 0; j < n; j++) {
-        cell_coords(s, vpdsi_rng_below(rng, total), c);
-        vpdsi_cell_box(s, level, c, lo, hi);
+        cell_coords(m, ctx, vpdsi_rng_below(rng, total), c);
+        vpdsi_lattice_box(&m->run.geom, level, c, lo, hi);
         for (k = 0; k < d; k++) {
             double v = lo[k] + vpdsi_rng_unit(rng) * (hi[k] - lo[k]);
             out[j * (size_t)d + (size_t)k] = v > hi[k] ? hi[k] : v;
@@ -185,184 +203,168 @@ static void draw_darts(const vpds_sampler *s, vpdsi_rng *rng, size_t n, double *
     }
 }
 
-static vpds_status reserve_buffers(vpds_sampler *s, size_t n)
+static vpds_status reserve_buffers(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
 {
     size_t nx;
-    if (vpdsi_mul_size(n, (size_t)s->dim, &nx) ||
-        vpdsi_mem_reserve(&s->mem, (void **)&s->buf_x, &s->cap_buf_x, nx, sizeof(double)) ||
-        vpdsi_mem_reserve(&s->mem, (void **)&s->buf_r, &s->cap_buf_r, n, sizeof(double))) {
-        vpdsi_set_error(s, "out of memory for a chunk of %zu points", n);
+    if (vpdsi_mul_size(n, (size_t)ctx->pb->dim, &nx) ||
+        vpdsi_mem_reserve(ctx->mem, (void **)&m->buf_x, &m->cap_buf_x, nx, sizeof(double)) ||
+        vpdsi_mem_reserve(ctx->mem, (void **)&m->buf_r, &m->cap_buf_r, n, sizeof(double))) {
+        vpdsi_store_error(ctx->st, "out of memory for a chunk of %zu points", n);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
     return VPDS_OK;
 }
 
-static int32_t grid_conflict(const vpds_sampler *s, const double *y, double reach)
-{
-    const vpdsi_bgrid *g = &s->grid;
-    const int32_t *cell = g->cell + vpdsi_bgrid_locate(g, y);
-    double reach2 = reach * reach;
-    size_t j;
-    int k, d = s->dim;
-    if (cell[0] >= 0) return cell[0]; /* a cell holds one sample: any other point conflicts */
-    for (j = 0; j < g->n_stencil; j++) {
-        int32_t i = cell[g->stencil[j]];
-        if (i >= 0) {
-            const double *x = s->x + (size_t)i * (size_t)d;
-            double d2 = 0;
-            for (k = 0; k < d; k++) d2 += (y[k] - x[k]) * (y[k] - x[k]);
-            if (d2 < reach2) return i;
-        }
-    }
-    return -1;
-}
-
 /* An error at dart j of a chunk: keep the darts before it, as a pause would, and spend no
  * draw on the rest (a retry throws the same darts). */
-static void keep_darts_before(vpds_sampler *s, const vpdsi_rng *start, size_t j, int weighted)
+static void keep_darts_before(vpdsi_mps *m, const vpdsi_ctx *ctx, const vpdsi_rng *start, size_t j, int weighted)
 {
-    s->rng = *start;
-    draw_darts(s, &s->rng, j, s->buf_x, weighted ? s->buf_u : NULL);
-    s->run.darts_left -= j;
-    s->stats.darts += j;
+    *ctx->rng = *start;
+    draw_darts(m, ctx, ctx->rng, j, m->buf_x, weighted ? m->buf_u : NULL);
+    m->run.darts_left -= j;
+    ctx->stats->darts += j;
 }
 
-static vpds_status darts_chunk(vpds_sampler *s, size_t n)
+static vpds_status darts_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
 {
-    int d = s->dim;
-    int varying = s->sizing.kind != VPDSI_SIZING_CONSTANT;
-    int weighted = s->weighted && varying;
-    double scale = s->run.t * s->inhibition;
-    vpdsi_rng start = s->rng;
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_store *st = ctx->st;
+    int d = pb->dim;
+    int varying = st->sizing.kind != VPDSI_SIZING_CONSTANT;
+    int weighted = pb->weighted && varying;
+    double scale = m->run.t * pb->inhibition;
+    vpdsi_rng start = *ctx->rng;
     vpdsi_kd_samples view;
-    vpds_status st;
+    vpds_status e;
     size_t j;
-    if ((st = reserve_buffers(s, n)) != VPDS_OK) return st;
-    if ((st = vpdsi_reserve_samples(s, n)) != VPDS_OK) return st;
-    if (weighted && vpdsi_mem_reserve(&s->mem, (void **)&s->buf_u, &s->cap_buf_u, n, sizeof(double))) {
-        vpdsi_set_error(s, "out of memory for a chunk of %zu darts", n);
+    if ((e = reserve_buffers(m, ctx, n)) != VPDS_OK) return e;
+    if ((e = vpdsi_store_reserve(st, n)) != VPDS_OK) return e;
+    if (weighted && vpdsi_mem_reserve(ctx->mem, (void **)&m->buf_u, &m->cap_buf_u, n, sizeof(double))) {
+        vpdsi_store_error(st, "out of memory for a chunk of %zu darts", n);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
-    draw_darts(s, &s->rng, n, s->buf_x, weighted ? s->buf_u : NULL);
+    draw_darts(m, ctx, ctx->rng, n, m->buf_x, weighted ? m->buf_u : NULL);
     if (varying) {
-        st = vpdsi_sizing_eval(&s->sizing, s->buf_x, n, s->buf_r, s->err, sizeof s->err);
-        if (st != VPDS_OK) {
-            s->rng = start; /* no draw spent: a retry throws the same darts */
-            return st;
+        e = vpdsi_store_radii(st, m->buf_x, n, m->buf_r);
+        if (e != VPDS_OK) {
+            *ctx->rng = start; /* no draw spent: a retry throws the same darts */
+            return e;
         }
     } else {
-        for (j = 0; j < n; j++) s->buf_r[j] = s->sizing.radius;
+        for (j = 0; j < n; j++) m->buf_r[j] = st->sizing.radius;
     }
     if (weighted) {
         /* Eq. 12 by rejection: keep a dart with probability (r_min / r(y))^d, so accepted darts
          * have density proportional to 1 / r^d over the free region */
         for (j = 0; j < n; j++) {
-            if (s->buf_r[j] < s->sizing.rmin) {
+            if (m->buf_r[j] < st->sizing.rmin) {
                 char py[256];
-                vpdsi_format_point(py, sizeof py, s->buf_x + j * (size_t)d, d);
-                vpdsi_set_error(s, "sizing returned r = %.17g at x = (%s), below radius_min = %.17g",
-                                s->buf_r[j], py, s->sizing.rmin);
-                s->rng = start;
+                vpdsi_format_point(py, sizeof py, m->buf_x + j * (size_t)d, d);
+                vpdsi_store_error(st, "sizing returned r = %.17g at x = (%s), below radius_min = %.17g",
+                                m->buf_r[j], py, st->sizing.rmin);
+                *ctx->rng = start;
                 return VPDS_ERR_SIZING;
             }
             {
-                double ratio = s->sizing.rmin / s->buf_r[j], keep = 1;
+                double ratio = st->sizing.rmin / m->buf_r[j], keep = 1;
                 int k;
                 for (k = 0; k < d; k++) keep *= ratio;
-                s->buf_u[j] = s->buf_u[j] < keep ? 1.0 : 0.0;
+                m->buf_u[j] = m->buf_u[j] < keep ? 1.0 : 0.0;
             }
         }
     }
     for (j = 0; j < n; j++) {
-        const double *y = s->buf_x + j * (size_t)d;
+        const double *y = m->buf_x + j * (size_t)d;
         int32_t witness = -1, hit;
-        if (weighted && s->buf_u[j] == 0.0) continue;
-        if (s->grid_mode) {
-            hit = grid_conflict(s, y, scale * s->sizing.radius);
+        if (weighted && m->buf_u[j] == 0.0) continue;
+        if (st->grid_mode) {
+            hit = vpdsi_bgrid_conflict(&st->grid, st->x, y, scale * st->sizing.radius);
         } else {
-            view = vpdsi_samples_view(s);
-            hit = vpdsi_kd_conflict(&s->tree, &view, y, s->buf_r[j], (int)s->rule, scale,
-                                    varying ? s->sizing.lipschitz : -1.0, &witness);
+            view = vpdsi_store_view(st);
+            hit = vpdsi_kd_conflict(&st->tree, &view, y, m->buf_r[j], (int)pb->rule, scale,
+                                    varying ? st->sizing.lipschitz : -1.0, &witness);
         }
         if (hit == -2) {
             char py[256], px[256];
-            const double *x = s->x + (size_t)witness * (size_t)d;
+            const double *x = st->x + (size_t)witness * (size_t)d;
             double dist = 0;
             int k;
             for (k = 0; k < d; k++) dist += (y[k] - x[k]) * (y[k] - x[k]);
             dist = sqrt(dist);
             vpdsi_format_point(py, sizeof py, y, d);
             vpdsi_format_point(px, sizeof px, x, d);
-            vpdsi_set_error(s, "sizing breaks lipschitz = %g: r = %.17g at (%s) and r = %.17g at"
-                            " (%s), distance %.17g, slope %.17g", s->sizing.lipschitz,
-                            s->buf_r[j], py, s->r[witness], px, dist,
-                            fabs(s->buf_r[j] - s->r[witness]) / dist);
-            keep_darts_before(s, &start, j, weighted);
+            vpdsi_store_error(st, "sizing breaks lipschitz = %g: r = %.17g at (%s) and r = %.17g at"
+                            " (%s), distance %.17g, slope %.17g", st->sizing.lipschitz,
+                            m->buf_r[j], py, st->r[witness], px, dist,
+                            fabs(m->buf_r[j] - st->r[witness]) / dist);
+            keep_darts_before(m, ctx, &start, j, weighted);
             return VPDS_ERR_LIPSCHITZ;
         }
-        if (hit == -1 && s->domain) {
+        if (hit == -1 && ctx->dom->fn) {
             double phi;
-            if ((st = vpdsi_domain_at(s, y, &phi)) != VPDS_OK) {
-                keep_darts_before(s, &start, j, weighted);
-                return st;
+            if ((e = vpdsi_domain_at(ctx->dom, st, y, &phi)) != VPDS_OK) {
+                keep_darts_before(m, ctx, &start, j, weighted);
+                return e;
             }
             if (phi > 0) hit = -4; /* outside the domain: rejected, as uniform over it wants */
         }
-        if (hit == -1 && s->two_radii) {
+        if (hit == -1 && pb->two_radii) {
             /* Section 3.1, first option: the dart must cover a point not yet covered */
             int found = 0;
-            st = VPDS_OK;
-            if (vpdsi_uncovered_nearest(s, y) > vpdsi_coverage_reach(s, s->buf_r[j]) + s->u_half)
+            e = VPDS_OK;
+            if (vpdsi_uncovered_nearest(&m->unc, y) > coverage_reach(m, ctx, m->buf_r[j]) + m->unc.half)
                 found = 0; /* no cell that may hold an uncovered point is within reach */
             else
-                st = vpdsi_uncovered_in(s, y, y, s->buf_r[j], &found);
-            if (st != VPDS_OK) {
-                keep_darts_before(s, &start, j, weighted);
-                return st;
+                e = vpdsi_uncovered_in(&m->unc, ctx, m->run.t, y, y, m->buf_r[j], &found);
+            if (e != VPDS_OK) {
+                keep_darts_before(m, ctx, &start, j, weighted);
+                return e;
             }
             if (!found) hit = -3;
         }
         if (hit == -1) {
-            vpdsi_append_sample(s, y, s->buf_r[j], s->run.t, 0);
-            s->stats.accepted++;
+            vpdsi_store_append(st, y, m->buf_r[j], m->run.t, 0);
+            ctx->stats->accepted++;
         }
     }
-    s->run.darts_left -= n;
-    s->stats.darts += n;
+    m->run.darts_left -= n;
+    ctx->stats->darts += n;
     return VPDS_OK;
 }
 
-static int box_covered(const vpds_sampler *s, const double *lo, const double *hi, double r_lo,
+static int box_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, const double *lo, const double *hi, double r_lo,
                        double scale)
 {
-    vpdsi_kd_samples view = vpdsi_samples_view(s);
-    return vpdsi_kd_box_covered(&s->tree, &view, s->cand, s->n_cand, lo, hi, r_lo, (int)s->rule, scale);
+    vpdsi_kd_samples view = vpdsi_store_view(ctx->st);
+    return vpdsi_kd_box_covered(&ctx->st->tree, &view, m->cand, m->n_cand, lo, hi, r_lo, (int)ctx->pb->rule, scale);
 }
 
 /* Which of the 2^d children of cell c are covered whole by one candidate. A child's farthest
  * point from x is, on each axis, the farther end of its half; so per candidate all children's
  * squared farthest distances are sums of 2 values per axis, built child by child from a
  * neighbour that differs in one axis. Bit b of covered is child b (bit k: upper half on axis k). */
-static void children_covered(const vpds_sampler *s, unsigned level, const uint64_t *c, double r_lo,
+static void children_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned level, const uint64_t *c, double r_lo,
                              double scale, uint64_t *covered)
 {
-    int d = s->dim, k;
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_store *st = ctx->st;
+    int d = pb->dim, k;
     unsigned children = 1u << d, b;
     double lo[VPDS_MAX_DIM], mid[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], sums[1u << VPDS_MAX_DIM];
     uint64_t cc[VPDS_MAX_DIM] = {0};
     size_t j;
     for (k = 0; k < d; k++) cc[k] = 2 * c[k];
-    vpdsi_cell_box(s, level + 1, cc, lo, mid);
+    vpdsi_lattice_box(&m->run.geom, level + 1, cc, lo, mid);
     for (k = 0; k < d; k++) cc[k] = 2 * c[k] + 1;
-    vpdsi_cell_box(s, level + 1, cc, mid, hi);
-    for (j = 0; j < s->n_cand; j++) {
-        const double *x = s->x + (size_t)s->cand[j] * (size_t)d;
-        double f = scale * vpdsi_rule_f(s->rule, s->r[s->cand[j]], r_lo), f2 = f * f;
+    vpdsi_lattice_box(&m->run.geom, level + 1, cc, mid, hi);
+    for (j = 0; j < m->n_cand; j++) {
+        const double *x = st->x + (size_t)m->cand[j] * (size_t)d;
+        double f = scale * vpdsi_rule_f(pb->rule, st->r[m->cand[j]], r_lo), f2 = f * f;
         double far[VPDS_MAX_DIM][2], least = 0;
         if (!(f > 0)) continue;
         for (k = 0; k < d; k++) {
-            double a = vpdsi_axis_far(x[k], lo[k], mid[k], s->period[k]);
-            double z = vpdsi_axis_far(x[k], mid[k], hi[k], s->period[k]);
+            double a = vpdsi_axis_far(x[k], lo[k], mid[k], pb->period[k]);
+            double z = vpdsi_axis_far(x[k], mid[k], hi[k], pb->period[k]);
             far[k][0] = a * a;
             far[k][1] = z * z;
             least += far[k][0] < far[k][1] ? far[k][0] : far[k][1];
@@ -384,29 +386,30 @@ static void children_covered(const vpds_sampler *s, unsigned level, const uint64
  * child that lies outside the domain, and, with one radius, each whose part inside the domain
  * is covered by the union of disks (a search inside it); else such children would split along
  * the boundary down to the precision limit. Without a split the "child" is the cell itself. */
-static vpds_status drop_outside_children(vpds_sampler *s, unsigned level, const uint64_t *c,
+static vpds_status drop_outside_children(vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned level, const uint64_t *c,
                                          int split, const double *centre, double phi,
                                          uint64_t *covered)
 {
-    int d = s->dim, k;
+    const vpdsi_problem *pb = ctx->pb;
+    int d = pb->dim, k;
     unsigned children = split ? 1u << d : 1u, b;
     uint64_t cc[VPDS_MAX_DIM];
-    vpds_status st;
+    vpds_status e;
     for (b = 0; b < children; b++) {
         double clo[VPDS_MAX_DIM], chi[VPDS_MAX_DIM], cm[VPDS_MAX_DIM], half, phi_c = phi;
         int found = 1;
         if (covered[b >> 6] >> (b & 63u) & 1u) continue;
         for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
-        half = 0.5 * sqrt(vpdsi_cell_box(s, split ? level + 1 : level, cc, clo, chi));
+        half = 0.5 * sqrt(vpdsi_lattice_box(&m->run.geom, split ? level + 1 : level, cc, clo, chi));
         for (k = 0; k < d; k++) cm[k] = 0.5 * (clo[k] + chi[k]);
         if (split) {
-            if ((st = vpdsi_domain_at(s, cm, &phi_c)) != VPDS_OK) return st;
-            if ((st = vpdsi_domain_check_pair(s, centre, phi, cm, phi_c)) != VPDS_OK) return st;
+            if ((e = vpdsi_domain_at(ctx->dom, ctx->st, cm, &phi_c)) != VPDS_OK) return e;
+            if ((e = vpdsi_domain_check_pair(ctx->st, centre, phi, cm, phi_c)) != VPDS_OK) return e;
         }
         if (phi_c <= -half) continue; /* inside, whole: the usual rules apply */
-        if (phi_c <= half && !s->two_radii &&
-            (st = vpdsi_uncovered_in(s, clo, chi, 0.0, &found)) != VPDS_OK)
-            return st;
+        if (phi_c <= half && !pb->two_radii &&
+            (e = vpdsi_uncovered_in(&m->unc, ctx, m->run.t, clo, chi, 0.0, &found)) != VPDS_OK)
+            return e;
         if (phi_c > half || !found) covered[b >> 6] |= UINT64_C(1) << (b & 63u);
     }
     return VPDS_OK;
@@ -414,85 +417,87 @@ static vpds_status drop_outside_children(vpds_sampler *s, unsigned level, const 
 
 /* Sweep n cells from run->pos: drop covered ones, keep the others (split: their uncovered
  * children) in run->next. run->pos advances cell by cell, so an error mid-chunk loses nothing. */
-static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
+static vpds_status sweep_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, int split)
 {
-    vpdsi_run *run = &s->run;
-    int d = s->dim, k;
-    unsigned level = cur_level(s), children = split ? 1u << d : 1u, b;
-    int varying = s->sizing.kind != VPDSI_SIZING_CONSTANT;
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_store *st = ctx->st;
+    vpdsi_run *run = &m->run;
+    int d = pb->dim, k;
+    unsigned level = cur_level(m), children = split ? 1u << d : 1u, b;
+    int varying = st->sizing.kind != VPDSI_SIZING_CONSTANT;
     /* r over the cell: for a rule that reads r(y), and for the reach of two radii' V */
-    int need_r = varying && (vpdsi_rule_uses_y(s->rule) || s->two_radii);
+    int need_r = varying && (vpdsi_rule_uses_y(pb->rule) || pb->two_radii);
     /* a cell is dropped inside one inhibition disk (with one radius: one coverage disk) */
-    double scale = run->t * s->inhibition, L = s->sizing.lipschitz;
+    double scale = run->t * pb->inhibition, L = st->sizing.lipschitz;
     uint64_t c[VPDS_MAX_DIM], cc[VPDS_MAX_DIM];
     double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], centre[VPDS_MAX_DIM], phi = -INFINITY;
     size_t j, need;
-    vpds_status st;
+    vpds_status e;
     if (vpdsi_mul_size(n, children, &need) ||
-        vpdsi_cells_reserve(&run->next, &s->mem, run->next.count + need) ||
-        (s->two_radii && vpdsi_mem_reserve(&s->mem, (void **)&s->next_u, &s->cap_next_u,
+        vpdsi_cells_reserve(&run->next, ctx->mem, run->next.count + need) ||
+        (pb->two_radii && vpdsi_mem_reserve(ctx->mem, (void **)&m->unc.flag, &m->unc.cap_flag,
                                            run->next.count + need, 1))) {
-        vpdsi_set_error(s, "out of memory for the active cells of level %u", run->next.level);
+        vpdsi_store_error(st, "out of memory for the active cells of level %u", run->next.level);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
     if (need_r) {
         /* r at the cell centres bounds r over each cell through L */
-        if ((st = reserve_buffers(s, n)) != VPDS_OK) return st;
+        if ((e = reserve_buffers(m, ctx, n)) != VPDS_OK) return e;
         for (j = 0; j < n; j++) {
-            cell_coords(s, run->pos + j, c);
-            vpdsi_cell_box(s, level, c, lo, hi);
-            for (k = 0; k < d; k++) s->buf_x[j * (size_t)d + (size_t)k] = 0.5 * (lo[k] + hi[k]);
+            cell_coords(m, ctx, run->pos + j, c);
+            vpdsi_lattice_box(&m->run.geom, level, c, lo, hi);
+            for (k = 0; k < d; k++) m->buf_x[j * (size_t)d + (size_t)k] = 0.5 * (lo[k] + hi[k]);
         }
-        st = vpdsi_sizing_eval(&s->sizing, s->buf_x, n, s->buf_r, s->err, sizeof s->err);
-        if (st != VPDS_OK) return st;
+        e = vpdsi_store_radii(st, m->buf_x, n, m->buf_r);
+        if (e != VPDS_OK) return e;
     }
     for (j = 0; j < n; j++) {
-        double h = sqrt(vpdsi_cell_box(s, level, (cell_coords(s, run->pos, c), c), lo, hi));
-        double r_lo = s->sizing.radius, r_hi = s->sizing.radius;
+        double h = sqrt(vpdsi_lattice_box(&m->run.geom, level, (cell_coords(m, ctx, run->pos, c), c), lo, hi));
+        double r_lo = st->sizing.radius, r_hi = st->sizing.radius;
         uint64_t covered[4] = {0, 0, 0, 0};
         uint8_t flag[1u << VPDS_MAX_DIM]; /* two radii: the child may hold an uncovered point */
-        vpdsi_kd_samples view = vpdsi_samples_view(s);
+        vpdsi_kd_samples view = vpdsi_store_view(st);
         if (need_r) {
-            r_lo = s->buf_r[j] - L * h / 2;
-            r_hi = s->buf_r[j] + L * h / 2;
+            r_lo = m->buf_r[j] - L * h / 2;
+            r_hi = m->buf_r[j] + L * h / 2;
         }
-        if (s->domain) {
+        if (ctx->dom->fn) {
             for (k = 0; k < d; k++) centre[k] = 0.5 * (lo[k] + hi[k]);
-            if ((st = vpdsi_domain_at(s, centre, &phi)) != VPDS_OK) return st;
+            if ((e = vpdsi_domain_at(ctx->dom, st, centre, &phi)) != VPDS_OK) return e;
             if (phi > 0.5 * h) { /* outside the domain, whole */
                 run->pos++;
                 continue;
             }
         }
-        s->n_cand = 0;
-        if (s->grid_mode) {
+        m->n_cand = 0;
+        if (st->grid_mode) {
             uint64_t base[VPDS_MAX_DIM];
             for (k = 0; k < d; k++) base[k] = c[k] >> level; /* the base cell holding this one */
-            s->n_cand = vpdsi_bgrid_near(&s->grid, vpdsi_bgrid_index(&s->grid, base), s->cand);
-        } else if (vpdsi_kd_gather(&s->tree, &view, lo, hi, r_hi, (int)s->rule,
-                                   s->two_radii ? run->t * s->coverage : scale, split,
-                                   &s->mem, &s->cand, &s->n_cand, &s->cap_cand)) {
-            vpdsi_set_error(s, "out of memory gathering the samples near a cell");
+            m->n_cand = vpdsi_bgrid_near(&st->grid, vpdsi_bgrid_index(&st->grid, base), m->cand);
+        } else if (vpdsi_kd_gather(&st->tree, &view, lo, hi, r_hi, (int)pb->rule,
+                                   pb->two_radii ? run->t * pb->coverage : scale, split,
+                                   ctx->mem, &m->cand, &m->n_cand, &m->cap_cand)) {
+            vpdsi_store_error(st, "out of memory gathering the samples near a cell");
             return VPDS_ERR_OUT_OF_MEMORY;
         }
-        if (box_covered(s, lo, hi, r_lo, scale)) {
+        if (box_covered(m, ctx, lo, hi, r_lo, scale)) {
             run->pos++;
             continue;
         }
-        if (split) children_covered(s, level, c, r_lo, scale, covered);
-        if (s->domain && phi > -0.5 * h &&
-            (st = drop_outside_children(s, level, c, split, centre, phi, covered)) != VPDS_OK)
-            return st;
-        if (s->two_radii) {
+        if (split) children_covered(m, ctx, level, c, r_lo, scale, covered);
+        if (ctx->dom->fn && phi > -0.5 * h &&
+            (e = drop_outside_children(m, ctx, level, c, split, centre, phi, covered)) != VPDS_OK)
+            return e;
+        if (pb->two_radii) {
             /* which kept children may hold an uncovered point: not inside one coverage disk
              * (the gather above, at the larger coverage reach, found every candidate), and
              * not shown covered by a search inside them; decided before anything is kept */
             uint64_t cov_c[4] = {0, 0, 0, 0};
-            double scale_c = run->t * s->coverage;
-            if (box_covered(s, lo, hi, r_lo, scale_c)) {
+            double scale_c = run->t * pb->coverage;
+            if (box_covered(m, ctx, lo, hi, r_lo, scale_c)) {
                 cov_c[0] = cov_c[1] = cov_c[2] = cov_c[3] = ~UINT64_C(0);
             } else if (split) {
-                children_covered(s, level, c, r_lo, scale_c, cov_c);
+                children_covered(m, ctx, level, c, r_lo, scale_c, cov_c);
             }
             for (b = 0; b < children; b++) {
                 double clo[VPDS_MAX_DIM], chi[VPDS_MAX_DIM];
@@ -501,15 +506,15 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
                 if ((covered[b >> 6] >> (b & 63u) & 1u) || (cov_c[b >> 6] >> (b & 63u) & 1u))
                     continue;
                 for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
-                vpdsi_cell_box(s, split ? level + 1 : level, cc, clo, chi);
-                if ((st = vpdsi_uncovered_in(s, clo, chi, 0.0, &found)) != VPDS_OK) return st;
+                vpdsi_lattice_box(&m->run.geom, split ? level + 1 : level, cc, clo, chi);
+                if ((e = vpdsi_uncovered_in(&m->unc, ctx, m->run.t, clo, chi, 0.0, &found)) != VPDS_OK) return e;
                 flag[b] = (uint8_t)found;
             }
         }
         run->pos++;
         for (b = 0; b < children; b++) {
             if (covered[b >> 6] >> (b & 63u) & 1u) continue;
-            if (s->two_radii) s->next_u[run->next.count] = flag[b];
+            if (pb->two_radii) m->unc.flag[run->next.count] = flag[b];
             for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
             vpdsi_cells_push(&run->next, d, cc);
         }
@@ -519,34 +524,35 @@ static vpds_status sweep_chunk(vpds_sampler *s, size_t n, int split)
 
 /* Two radii (Figure 2): keep a new cell only if a cell that may hold an uncovered point lies
  * within the coverage reach of it; kept cells are compacted in place, in order. */
-static vpds_status vfilter_chunk(vpds_sampler *s, size_t n)
+static vpds_status vfilter_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
 {
-    vpdsi_run *run = &s->run;
-    int d = s->dim, k;
-    int varying = s->sizing.kind != VPDSI_SIZING_CONSTANT;
+    vpdsi_store *st = ctx->st;
+    vpdsi_run *run = &m->run;
+    int d = ctx->pb->dim, k;
+    int varying = st->sizing.kind != VPDSI_SIZING_CONSTANT;
     uint64_t c[VPDS_MAX_DIM];
     double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], centre[VPDS_MAX_DIM];
     size_t j;
-    vpds_status st;
-    if (!s->u_ready && (st = vpdsi_uncovered_index(s)) != VPDS_OK) return st;
+    vpds_status e;
+    if (!m->unc.ready && (e = vpdsi_uncovered_index(&m->unc, st, &m->run.next, &m->run.geom)) != VPDS_OK) return e;
     if (varying) {
-        if ((st = reserve_buffers(s, n)) != VPDS_OK) return st;
+        if ((e = reserve_buffers(m, ctx, n)) != VPDS_OK) return e;
         for (j = 0; j < n; j++) {
             vpdsi_cells_get(&run->next, (size_t)run->vpos + j, d, c);
-            vpdsi_cell_box(s, run->next.level, c, lo, hi);
-            for (k = 0; k < d; k++) s->buf_x[j * (size_t)d + (size_t)k] = 0.5 * (lo[k] + hi[k]);
+            vpdsi_lattice_box(&m->run.geom, run->next.level, c, lo, hi);
+            for (k = 0; k < d; k++) m->buf_x[j * (size_t)d + (size_t)k] = 0.5 * (lo[k] + hi[k]);
         }
-        st = vpdsi_sizing_eval(&s->sizing, s->buf_x, n, s->buf_r, s->err, sizeof s->err);
-        if (st != VPDS_OK) return st;
+        e = vpdsi_store_radii(st, m->buf_x, n, m->buf_r);
+        if (e != VPDS_OK) return e;
     }
     for (j = 0; j < n; j++) {
         size_t i = (size_t)run->vpos;
-        double h = 0.5 * sqrt(vpdsi_cell_box(s, run->next.level, (vpdsi_cells_get(&run->next, i, d, c), c), lo, hi));
-        double r_hi = varying ? s->buf_r[j] + s->sizing.lipschitz * h : s->sizing.radius;
+        double h = 0.5 * sqrt(vpdsi_lattice_box(&m->run.geom, run->next.level, (vpdsi_cells_get(&run->next, i, d, c), c), lo, hi));
+        double r_hi = varying ? m->buf_r[j] + st->sizing.lipschitz * h : st->sizing.radius;
         for (k = 0; k < d; k++) centre[k] = 0.5 * (lo[k] + hi[k]);
-        if (vpdsi_uncovered_nearest(s, centre) <= vpdsi_coverage_reach(s, r_hi) + h + s->u_half) {
+        if (vpdsi_uncovered_nearest(&m->unc, centre) <= coverage_reach(m, ctx, r_hi) + h + m->unc.half) {
             vpdsi_cells_move(&run->next, i, (size_t)run->wpos);
-            s->next_u[run->wpos] = s->next_u[i];
+            m->unc.flag[run->wpos] = m->unc.flag[i];
             run->wpos++;
         }
         run->vpos++;
@@ -555,19 +561,19 @@ static vpds_status vfilter_chunk(vpds_sampler *s, size_t n)
 }
 
 /* The sweep of a level is complete: its output becomes the active cells. */
-static void finish_sweep(vpds_sampler *s, int split)
+static void finish_sweep(vpdsi_mps *m, const vpdsi_ctx *ctx, int split)
 {
-    vpdsi_run *run = &s->run;
+    vpdsi_run *run = &m->run;
     vpdsi_cells tmp = run->cur;
     run->cur = run->next;
     run->next = tmp;
     run->implicit = 0;
     run->pos = 0;
-    if (run->cur.count > s->stats.peak_active_cells) s->stats.peak_active_cells = run->cur.count;
-    if (run->cur.level + 1 > s->stats.levels) s->stats.levels = run->cur.level + 1;
+    if (run->cur.count > ctx->stats->peak_active_cells) ctx->stats->peak_active_cells = run->cur.count;
+    if (run->cur.level + 1 > ctx->stats->levels) ctx->stats->levels = run->cur.level + 1;
     if (run->cur.count == 0) {
         run->phase = VPDSI_DONE;
-        s->stats.delta = 0;
+        ctx->stats->delta = 0;
     } else if (!split && run->phase == VPDSI_SWEEP) {
         /* precision limit: report how far from maximal the set may be */
         uint64_t c[VPDS_MAX_DIM] = {0};
@@ -575,65 +581,66 @@ static void finish_sweep(vpds_sampler *s, int split)
         size_t i;
         for (i = 0; i < run->cur.count; i++) {
             double dg;
-            vpdsi_cells_get(&run->cur, i, s->dim, c);
-            dg = sqrt(vpdsi_cell_box(s, run->cur.level, c, lo, hi));
+            vpdsi_cells_get(&run->cur, i, ctx->pb->dim, c);
+            dg = sqrt(vpdsi_lattice_box(&m->run.geom, run->cur.level, c, lo, hi));
             if (dg > worst) worst = dg;
         }
-        s->stats.delta = worst;
+        ctx->stats->delta = worst;
         run->phase = VPDSI_DONE;
     } else {
         run->phase = VPDSI_DARTS;
         run->darts_left = darts_for(run->cur.count, run->cur.level);
     }
-    if (run->phase == VPDSI_DONE) vpdsi_mps_release(s);
+    if (run->phase == VPDSI_DONE) vpdsi_mps_release_cells(m, ctx->st);
 }
 
-static void begin_sweep(vpds_sampler *s, int split)
+static void begin_sweep(vpdsi_mps *m, const vpdsi_ctx *ctx, int split)
 {
-    vpdsi_cells_layout(&s->run.next, s->dim, s->run.n0, cur_level(s) + (split ? 1u : 0u));
-    s->run.pos = 0;
+    vpdsi_cells_layout(&m->run.next, ctx->pb->dim, m->run.geom.n0, cur_level(m) + (split ? 1u : 0u));
+    m->run.pos = 0;
 }
 
-vpds_status vpdsi_mps_run(vpds_sampler *s)
+vpds_status vpdsi_mps_run(vpdsi_mps *m, const vpdsi_ctx *ctx, const vpdsi_work *w)
 {
-    vpdsi_run *run = &s->run;
+    vpdsi_store *st = ctx->st;
+    vpdsi_run *run = &m->run;
     uint64_t work = 0;
-    vpds_status st = VPDS_OK;
+    vpds_status e = VPDS_OK;
     if (run->phase == VPDSI_DONE) return VPDS_OK;
     if (run->phase == VPDSI_IDLE) {
-        if ((st = setup(s)) != VPDS_OK) return st;
-        if (run->phase == VPDSI_FILTER) begin_sweep(s, 0);
+        if ((e = setup(m, ctx, w->keep_tree)) != VPDS_OK) return e;
+        if (run->phase == VPDSI_FILTER) begin_sweep(m, ctx, 0);
     }
     for (;;) {
         uint64_t limit = CHUNK, before;
-        if (run->phase == VPDSI_DONE && s->n == 0 && s->domain) {
+        if (run->phase == VPDSI_DONE && st->n == 0 && ctx->dom->fn) {
             /* nothing to sample: say so, and leave the sampler as it was */
-            vpdsi_mps_reset(s, run->t);
-            vpdsi_set_error(s, "domain: no point of the box with sdf <= 0 was found (the domain is"
+            vpdsi_mps_reset(m, run->t);
+            vpdsi_store_error(st, "domain: no point of the box with sdf <= 0 was found (the domain is"
                             " empty, or too thin for darts to land in)");
             return VPDS_ERR_DOMAIN;
         }
         if (run->phase == VPDSI_DONE) return VPDS_OK;
-        if (s->budget && work >= s->budget) return VPDS_PAUSED;
-        if (s->budget && s->budget - work < limit) limit = s->budget - work;
+        if (w->budget && work >= w->budget) return VPDS_PAUSED;
+        if (w->budget && w->budget - work < limit) limit = w->budget - work;
         switch (run->phase) {
         case VPDSI_FILTER:
         case VPDSI_SWEEP: {
-            int split = run->phase == VPDSI_SWEEP && cur_level(s) < run->max_level;
-            uint64_t total = cur_count(s);
+            int split = run->phase == VPDSI_SWEEP && cur_level(m) < run->max_level;
+            uint64_t total = cur_count(m);
             before = run->pos;
             if (total - run->pos < limit) limit = total - run->pos;
-            st = sweep_chunk(s, (size_t)limit, split);
+            e = sweep_chunk(m, ctx, (size_t)limit, split);
             work += run->pos - before;
-            if (st != VPDS_OK) return st;
+            if (e != VPDS_OK) return e;
             if (run->pos == total) {
-                if (s->two_radii) {
+                if (ctx->pb->two_radii) {
                     run->vsplit = split | (run->phase == VPDSI_FILTER ? 2 : 0);
                     run->vpos = run->wpos = 0;
-                    s->u_ready = 0;
+                    m->unc.ready = 0;
                     run->phase = VPDSI_VFILTER;
                 } else {
-                    finish_sweep(s, split);
+                    finish_sweep(m, ctx, split);
                 }
             }
             break;
@@ -642,40 +649,40 @@ vpds_status vpdsi_mps_run(vpds_sampler *s)
             uint64_t total = run->next.count;
             before = run->vpos;
             if (total - run->vpos < limit) limit = total - run->vpos;
-            st = vfilter_chunk(s, (size_t)limit);
+            e = vfilter_chunk(m, ctx, (size_t)limit);
             work += run->vpos - before;
-            if (st != VPDS_OK) return st;
+            if (e != VPDS_OK) return e;
             if (run->vpos == total) {
                 run->next.count = (size_t)run->wpos;
                 /* finish_sweep tells a precision stop by the phase: restore the sweep's */
                 run->phase = run->vsplit & 2 ? VPDSI_FILTER : VPDSI_SWEEP;
-                finish_sweep(s, run->vsplit & 1);
+                finish_sweep(m, ctx, run->vsplit & 1);
             }
             break;
         }
         case VPDSI_DARTS:
             if (run->darts_left == 0) {
                 run->phase = VPDSI_SWEEP;
-                begin_sweep(s, cur_level(s) < run->max_level);
+                begin_sweep(m, ctx, cur_level(m) < run->max_level);
                 continue;
             }
             if (run->darts_left < limit) limit = run->darts_left;
             before = run->darts_left;
-            st = darts_chunk(s, (size_t)limit);
+            e = darts_chunk(m, ctx, (size_t)limit);
             work += before - run->darts_left;
-            if (st != VPDS_OK) return st;
+            if (e != VPDS_OK) return e;
             break;
         default:
             return VPDS_ERR_STATE;
         }
-        if (s->progress) {
+        if (w->progress) {
             vpds_progress p;
-            p.darts = s->stats.darts;
-            p.samples = s->n;
-            p.active_cells = run->phase == VPDSI_DONE ? 0 : cur_count(s);
-            p.level = cur_level(s);
+            p.darts = ctx->stats->darts;
+            p.samples = st->n;
+            p.active_cells = run->phase == VPDSI_DONE ? 0 : cur_count(m);
+            p.level = cur_level(m);
             p.t = run->t;
-            if (s->progress(&p, s->progress_user) != 0)
+            if (w->progress(&p, w->user) != 0)
                 return run->phase == VPDSI_DONE ? VPDS_OK : VPDS_PAUSED;
         }
     }

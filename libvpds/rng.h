@@ -7,6 +7,14 @@ typedef struct vpdsi_rng {
     uint64_t s[4];
 } vpdsi_rng;
 
+/* The splitmix64 finaliser: a bijection that scatters nearby inputs (seeds of tiles). */
+static inline uint64_t vpdsi_mix64(uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
 void vpdsi_rng_seed(vpdsi_rng *r, uint64_t seed);
 /* Uniform in [0, n) exactly (rejection on a power-of-two mask), n >= 1. */
 uint64_t vpdsi_rng_below(vpdsi_rng *r, uint64_t n);

@@ -61,3 +61,85 @@ vpds_status vpdsi_sizing_eval(vpdsi_sizing *s, const double *x, size_t n, double
     }
     return VPDS_OK;
 }
+
+void vpdsi_sizing_bounds(const vpds_desc *d, double *L, double *rmin, double *rmax)
+{
+    if (d->sizing || d->sizing_batch) {
+        *L = d->lipschitz;
+        *rmin = d->radius_min;
+        *rmax = d->radius_max;
+    } else if (d->sizing_grid) {
+        *L = d->lipschitz != VPDS_UNSET ? d->lipschitz : d->sizing_grid->lipschitz;
+        *rmin = d->sizing_grid->vmin;
+        *rmax = d->sizing_grid->vmax;
+    } else {
+        *L = 0;
+        *rmin = *rmax = d->radius;
+    }
+}
+
+vpds_status vpdsi_sizing_from_desc(vpdsi_sizing *s, const vpds_desc *d)
+{
+    vpds_status st;
+    s->dim = d->dim;
+    if (d->sizing || d->sizing_batch) {
+        s->kind = VPDSI_SIZING_CALLBACK;
+        s->fn = d->sizing;
+        s->batch = d->sizing_batch;
+        s->user = d->sizing_user;
+    } else if (d->sizing_grid) {
+        if ((st = vpdsi_grid_clone(d->sizing_grid, &d->allocator, &s->grid)) != VPDS_OK) return st;
+        s->kind = VPDSI_SIZING_GRID;
+    } else {
+        s->kind = VPDSI_SIZING_CONSTANT;
+        s->radius = d->radius;
+    }
+    vpdsi_sizing_bounds(d, &s->lipschitz, &s->rmin, &s->rmax);
+    return VPDS_OK;
+}
+
+/* r_max only sizes the base cells of the kd-tree path (never a correctness bound there), so
+ * estimate it from r on a lattice of up to 4096 points, capped by the bound that L gives from
+ * the box's centre. */
+vpds_status vpdsi_sizing_estimate_rmax(vpdsi_sizing *s, vpdsi_mem *m, const double *lo,
+                                       const double *hi, char *err, size_t cap)
+{
+    double c[VPDS_MAX_DIM] = {0}, rc, diag2 = 0, best = 0, *pts, *r;
+    int k, d = s->dim, per = 2;
+    size_t n = 1, i, bytes;
+    vpds_status st;
+    if (s->rmax > 0) return VPDS_OK;
+    for (k = 0; k < d; k++) {
+        c[k] = 0.5 * (lo[k] + hi[k]);
+        diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    }
+    if ((st = vpdsi_sizing_eval(s, c, 1, &rc, err, cap)) != VPDS_OK) return st;
+    while (per < 64 && n * (size_t)(per + 1) <= 4096) {
+        per++;
+        for (n = 1, k = 0; k < d; k++) n *= (size_t)per;
+    }
+    for (n = 1, k = 0; k < d; k++) n *= (size_t)per;
+    bytes = n * ((size_t)d + 1) * sizeof(double);
+    if (!(pts = (double *)vpdsi_mem_alloc(m, bytes))) {
+        if (err && cap) snprintf(err, cap, "out of memory estimating the largest radius");
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    r = pts + n * (size_t)d;
+    for (i = 0; i < n; i++) {
+        size_t rest = i;
+        for (k = 0; k < d; k++) {
+            size_t j = rest % (size_t)per;
+            rest /= (size_t)per;
+            pts[i * (size_t)d + (size_t)k] = lo[k] + (hi[k] - lo[k]) * (double)j / (double)(per - 1);
+        }
+    }
+    st = vpdsi_sizing_eval(s, pts, n, r, err, cap);
+    for (i = 0; st == VPDS_OK && i < n; i++)
+        if (r[i] > best) best = r[i];
+    vpdsi_mem_free(m, pts, bytes);
+    if (st != VPDS_OK) return st;
+    if (rc > best) best = rc;
+    s->rmax = best;
+    if (rc + s->lipschitz * sqrt(diag2) / 2 < best) s->rmax = rc + s->lipschitz * sqrt(diag2) / 2;
+    return VPDS_OK;
+}

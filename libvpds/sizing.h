@@ -3,6 +3,7 @@
 #ifndef VPDS_SIZING_H
 #define VPDS_SIZING_H
 #include "grid.h"
+#include "mem.h"
 
 /* Distances are compared squared; beyond these ranges the squares overflow or underflow and a
  * conflict could be missed: coordinates within 1e150, extents at least 1e-150, radii within
@@ -32,6 +33,13 @@ typedef struct vpdsi_sizing {
     uint64_t calls;
 } vpdsi_sizing;
 
+/* L, r_min and r_max that a descriptor's sizing implies (r_min 0, r_max 0: unknown). */
+void vpdsi_sizing_bounds(const vpds_desc *d, double *L, double *rmin, double *rmax);
+/* The sizing of a descriptor (a grid is cloned through the allocator a). */
+vpds_status vpdsi_sizing_from_desc(vpdsi_sizing *s, const vpds_desc *d);
+/* Unknown r_max with a callback: estimate it over the box [lo, hi] (see sizing.c). */
+vpds_status vpdsi_sizing_estimate_rmax(vpdsi_sizing *s, vpdsi_mem *m, const double *lo,
+                                       const double *hi, char *err, size_t cap);
 /* r at n points into out. On a bad value returns VPDS_ERR_SIZING and says where in err. */
 vpds_status vpdsi_sizing_eval(vpdsi_sizing *s, const double *x, size_t n, double *out, char *err,
                               size_t cap);

@@ -8,8 +8,8 @@
  * region is re-searched lazily when it reaches the top. The sample inserted at t* covers the
  * maximiser y*: y* itself with one radius (farthest-point insertion), else a point drawn
  * uniformly from those that are free at t* * inhibition and cover y* at t* * coverage. */
+#include "stream.h"
 #include "rules.h"
-#include "sampler.h"
 #include "torus.h"
 #include <math.h>
 #include <string.h>
@@ -18,23 +18,23 @@
 #define STREAM_SEARCH_BUDGET 200000 /* box splits per search before VPDS_ERR_DOMAIN */
 #define STREAM_SPLIT 1.0 /* a region splits while its half-diagonal exceeds STREAM_SPLIT * t * coverage * r */
 
-void vpdsi_stream_init(vpdsi_stream *st)
+void vpdsi_stream_init(vpdsi_stream *sm)
 {
-    memset(st, 0, sizeof *st);
+    memset(sm, 0, sizeof *sm);
 }
 
-void vpdsi_stream_release(vpdsi_stream *st, vpdsi_mem *m)
+void vpdsi_stream_release(vpdsi_stream *sm, vpdsi_mem *m)
 {
-    vpdsi_mem_free(m, st->heap, st->cap * sizeof(uint64_t));
-    vpdsi_mem_free(m, st->boxes, st->cap_boxes * sizeof(double));
-    vpdsi_mem_free(m, st->buf, st->cap_buf * sizeof(double));
-    vpdsi_stream_init(st);
+    vpdsi_mem_free(m, sm->heap, sm->cap * sizeof(uint64_t));
+    vpdsi_mem_free(m, sm->boxes, sm->cap_boxes * sizeof(double));
+    vpdsi_mem_free(m, sm->buf, sm->cap_buf * sizeof(double));
+    vpdsi_stream_init(sm);
 }
 
 /* ---- the region heap: records of (key, level, coordinates) ---- */
 
 /* key, level, g at the cached maximiser (-1: none), coordinates[dim], maximiser[dim] */
-static size_t rec_words(const vpds_sampler *s) { return 3 + 2 * (size_t)s->dim; }
+static size_t rec_words(const vpdsi_stream *sm) { return 3 + 2 * (size_t)sm->geom.dim; }
 #define REC_COORD 3
 
 static double rec_key(const uint64_t *r)
@@ -55,103 +55,101 @@ static void rec_swap(uint64_t *a, uint64_t *b, size_t w)
 }
 
 /* Push (after a reserve): sift up. */
-static void heap_push(vpds_sampler *s, double key, uint64_t level, const uint64_t *c, double gy,
+static void heap_push(vpdsi_stream *sm, double key, uint64_t level, const uint64_t *c, double gy,
                       const double *y)
 {
-    vpdsi_stream *st = &s->stream;
-    size_t w = rec_words(s), i = st->count++;
-    uint64_t *r = st->heap + i * w;
+    int d = sm->geom.dim;
+    size_t w = rec_words(sm), i = sm->count++;
+    uint64_t *r = sm->heap + i * w;
     memcpy(r, &key, sizeof key);
     r[1] = level;
     memcpy(r + 2, &gy, sizeof gy);
-    memcpy(r + REC_COORD, c, (size_t)s->dim * sizeof(uint64_t));
-    if (y) memcpy(r + REC_COORD + s->dim, y, (size_t)s->dim * sizeof(double));
+    memcpy(r + REC_COORD, c, (size_t)d * sizeof(uint64_t));
+    if (y) memcpy(r + REC_COORD + d, y, (size_t)d * sizeof(double));
     while (i > 0) {
         size_t p = (i - 1) / 2;
-        if (!(rec_key(st->heap + p * w) < rec_key(st->heap + i * w))) break;
-        rec_swap(st->heap + p * w, st->heap + i * w, w);
+        if (!(rec_key(sm->heap + p * w) < rec_key(sm->heap + i * w))) break;
+        rec_swap(sm->heap + p * w, sm->heap + i * w, w);
         i = p;
     }
 }
 
 /* Remove the top into out (w words). */
-static void heap_pop(vpds_sampler *s, uint64_t *out)
+static void heap_pop(vpdsi_stream *sm, uint64_t *out)
 {
-    vpdsi_stream *st = &s->stream;
-    size_t w = rec_words(s), i = 0, n;
-    memcpy(out, st->heap, w * sizeof(uint64_t));
-    n = --st->count;
+    size_t w = rec_words(sm), i = 0, n;
+    memcpy(out, sm->heap, w * sizeof(uint64_t));
+    n = --sm->count;
     if (n == 0) return;
-    memcpy(st->heap, st->heap + n * w, w * sizeof(uint64_t));
+    memcpy(sm->heap, sm->heap + n * w, w * sizeof(uint64_t));
     for (;;) {
         size_t l = 2 * i + 1, r = l + 1, m = i;
-        if (l < n && rec_key(st->heap + l * w) > rec_key(st->heap + m * w)) m = l;
-        if (r < n && rec_key(st->heap + r * w) > rec_key(st->heap + m * w)) m = r;
+        if (l < n && rec_key(sm->heap + l * w) > rec_key(sm->heap + m * w)) m = l;
+        if (r < n && rec_key(sm->heap + r * w) > rec_key(sm->heap + m * w)) m = r;
         if (m == i) break;
-        rec_swap(st->heap + m * w, st->heap + i * w, w);
+        rec_swap(sm->heap + m * w, sm->heap + i * w, w);
         i = m;
     }
 }
 
-static int heap_reserve(vpds_sampler *s, size_t more)
+static int heap_reserve(vpdsi_stream *sm, vpdsi_mem *mem, size_t more)
 {
-    vpdsi_stream *st = &s->stream;
     size_t words;
-    if (vpdsi_mul_size(st->count + more, rec_words(s), &words)) return -1;
-    return vpdsi_mem_reserve(&s->mem, (void **)&st->heap, &st->cap, words, sizeof(uint64_t));
+    if (vpdsi_mul_size(sm->count + more, rec_words(sm), &words)) return -1;
+    return vpdsi_mem_reserve(mem, (void **)&sm->heap, &sm->cap, words, sizeof(uint64_t));
 }
 
 /* Box of a region as centre and half sides; the last region of an axis ends at the face. */
-static void region_box(const vpds_sampler *s, unsigned level, const uint64_t *c, double *centre,
+static void region_box(const vpdsi_stream *sm, unsigned level, const uint64_t *c, double *centre,
                        double *half)
 {
-    const vpdsi_stream *st = &s->stream;
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
     int k;
-    for (k = 0; k < s->dim; k++) {
-        double side = ldexp(st->side0[k], -(int)level);
-        uint64_t last = (st->n0[k] << level) - 1;
-        double lo = s->lo[k] + (double)c[k] * side;
-        double hi = c[k] == last ? s->hi[k] : s->lo[k] + (double)(c[k] + 1) * side;
-        centre[k] = 0.5 * (lo + hi);
-        half[k] = 0.5 * (hi - lo);
+    vpdsi_lattice_box(&sm->geom, level, c, lo, hi);
+    for (k = 0; k < sm->geom.dim; k++) {
+        centre[k] = 0.5 * (lo[k] + hi[k]);
+        half[k] = 0.5 * (hi[k] - lo[k]);
     }
 }
 
-static vpds_status build_regions(vpds_sampler *s)
+static vpds_status build_regions(vpdsi_stream *sm, const vpdsi_ctx *ctx)
 {
-    vpdsi_stream *st = &s->stream;
-    int d = s->dim, k;
+    const vpdsi_problem *pb = ctx->pb;
+    int d = pb->dim, k;
     double side = INFINITY;
     uint64_t total = 1, i, c[VPDS_MAX_DIM];
+    sm->geom.dim = d;
+    memcpy(sm->geom.lo, pb->lo, sizeof sm->geom.lo);
+    memcpy(sm->geom.hi, pb->hi, sizeof sm->geom.hi);
     for (k = 0; k < d; k++)
-        if (s->hi[k] - s->lo[k] < side) side = s->hi[k] - s->lo[k];
+        if (pb->hi[k] - pb->lo[k] < side) side = pb->hi[k] - pb->lo[k];
     for (k = 0; k < d; k++) {
-        double cells = ceil((s->hi[k] - s->lo[k]) / side * (1 - 1e-12));
+        double cells = ceil((pb->hi[k] - pb->lo[k]) / side * (1 - 1e-12));
         if (cells > 64) cells = 64; /* long boxes: start coarser, regions split on demand */
-        st->n0[k] = cells < 1 ? 1 : (uint64_t)cells;
-        st->side0[k] = (s->hi[k] - s->lo[k]) / (double)st->n0[k];
-        total *= st->n0[k];
+        sm->geom.n0[k] = cells < 1 ? 1 : (uint64_t)cells;
+        sm->geom.side0[k] = (pb->hi[k] - pb->lo[k]) / (double)sm->geom.n0[k];
+        total *= sm->geom.n0[k];
     }
     /* coordinates of the finest regions must fit in 64-bit integers, and stay well above
      * the precision of doubles */
-    st->max_level = 40;
+    sm->max_level = 40;
     for (k = 0; k < d; k++) {
-        unsigned cap = 62 - vpdsi_bit_length(st->n0[k]);
-        if (cap < st->max_level) st->max_level = cap;
+        unsigned cap = 62 - vpdsi_bit_length(sm->geom.n0[k]);
+        if (cap < sm->max_level) sm->max_level = cap;
     }
-    if (heap_reserve(s, (size_t)total)) {
-        vpdsi_set_error(s, "out of memory for %llu stream regions", (unsigned long long)total);
+    if (heap_reserve(sm, ctx->mem, (size_t)total)) {
+        vpdsi_store_error(ctx->st, "out of memory for %llu stream regions", (unsigned long long)total);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
     for (i = 0; i < total; i++) {
         uint64_t rest = i;
         for (k = 0; k < d; k++) {
-            c[k] = rest % st->n0[k];
-            rest /= st->n0[k];
+            c[k] = rest % sm->geom.n0[k];
+            rest /= sm->geom.n0[k];
         }
-        heap_push(s, INFINITY, 0, c, -1.0, NULL);
+        heap_push(sm, INFINITY, 0, c, -1.0, NULL);
     }
-    st->active = 1;
+    sm->active = 1;
     return VPDS_OK;
 }
 
@@ -159,43 +157,44 @@ static vpds_status build_regions(vpds_sampler *s)
 
 /* Exact g at each of n centres (and argmin), and an upper bound of g over the box of half
  * sides half around each: (|c - x*| + h) / f(r(x*), r(c) - L h), x* the argmin at c. */
-static vpds_status eval_boxes(vpds_sampler *s, const double *centres, size_t n, const double *half,
+static vpds_status eval_boxes(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centres, size_t n, const double *half,
                               double *g, double *ub)
 {
-    vpdsi_stream *st = &s->stream;
-    int d = s->dim, k;
-    int need_r = vpdsi_rule_uses_y(s->rule) && s->sizing.kind != VPDSI_SIZING_CONSTANT;
-    double h = 0, L = s->sizing.lipschitz;
-    vpdsi_kd_samples v = vpdsi_samples_view(s);
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_store *st = ctx->st;
+    int d = pb->dim, k;
+    int need_r = vpdsi_rule_uses_y(pb->rule) && st->sizing.kind != VPDSI_SIZING_CONSTANT;
+    double h = 0, L = st->sizing.lipschitz;
+    vpdsi_kd_samples v = vpdsi_store_view(st);
     vpds_status e;
     size_t j;
     for (k = 0; k < d; k++) h += half[k] * half[k];
     h = sqrt(h);
-    if (vpdsi_mem_reserve(&s->mem, (void **)&st->buf, &st->cap_buf, n, sizeof(double))) {
-        vpdsi_set_error(s, "out of memory in the stream's search");
+    if (vpdsi_mem_reserve(ctx->mem, (void **)&sm->buf, &sm->cap_buf, n, sizeof(double))) {
+        vpdsi_store_error(st, "out of memory in the stream's search");
         return VPDS_ERR_OUT_OF_MEMORY;
     }
     if (need_r) {
-        if ((e = vpdsi_sizing_eval(&s->sizing, centres, n, st->buf, s->err, sizeof s->err)) != VPDS_OK)
+        if ((e = vpdsi_store_radii(st, centres, n, sm->buf)) != VPDS_OK)
             return e;
     } else {
-        for (j = 0; j < n; j++) st->buf[j] = s->sizing.radius;
+        for (j = 0; j < n; j++) sm->buf[j] = st->sizing.radius;
     }
     for (j = 0; j < n; j++) {
         const double *c = centres + j * (size_t)d;
-        double rc = st->buf[j], r_lo = rc - L * h, phi = 0;
+        double rc = sm->buf[j], r_lo = rc - L * h, phi = 0;
         int32_t arg;
         double q;
-        if (s->domain) {
+        if (ctx->dom->fn) {
             /* a box outside the domain holds no candidate; a centre outside is none itself */
-            if ((e = vpdsi_domain_at(s, c, &phi)) != VPDS_OK) return e;
+            if ((e = vpdsi_domain_at(ctx->dom, st, c, &phi)) != VPDS_OK) return e;
             if (phi > h) {
                 g[j] = ub[j] = -1;
                 continue;
             }
         }
-        q = vpdsi_kd_min_ratio(&s->tree, &v, c, 0.0, rc, (int)s->rule, &arg);
-        g[j] = phi > 0 ? -1 : q / s->coverage;
+        q = vpdsi_kd_min_ratio(&st->tree, &v, c, 0.0, rc, (int)pb->rule, &arg);
+        g[j] = phi > 0 ? -1 : q / pb->coverage;
         if (arg < 0) {
             ub[j] = INFINITY;
             continue;
@@ -203,13 +202,13 @@ static vpds_status eval_boxes(vpds_sampler *s, const double *centres, size_t n, 
         if (!(r_lo > 0)) r_lo = 0;
         {
             /* the farthest point of the box from x* (nearest image), tighter than |c - x*| + h */
-            const double *xa = s->x + (size_t)arg * (size_t)d;
-            double far2 = 0, f = vpdsi_rule_f(s->rule, s->r[arg], r_lo);
+            const double *xa = st->x + (size_t)arg * (size_t)d;
+            double far2 = 0, f = vpdsi_rule_f(pb->rule, st->r[arg], r_lo);
             for (k = 0; k < d; k++) {
-                double e = vpdsi_axis_far(xa[k], c[k] - half[k], c[k] + half[k], s->period[k]);
+                double e = vpdsi_axis_far(xa[k], c[k] - half[k], c[k] + half[k], pb->period[k]);
                 far2 += e * e;
             }
-            ub[j] = f > 0 ? sqrt(far2) / (f * s->coverage) : INFINITY;
+            ub[j] = f > 0 ? sqrt(far2) / (f * pb->coverage) : INFINITY;
         }
     }
     return VPDS_OK;
@@ -219,32 +218,32 @@ static vpds_status eval_boxes(vpds_sampler *s, const double *centres, size_t n, 
  * bound of g over the region and g(y) = *gy >= *bound / (1 + tolerance). With a domain the
  * tolerance is VPDS_STREAM_DOMAIN_TOLERANCE: on a curved boundary g is often maximal where it
  * varies quadratically along the boundary, so a tolerance eps costs about 1/eps boxes there. */
-static vpds_status search_region(vpds_sampler *s, const double *centre, const double *half,
+static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centre, const double *half,
                                  double *bound, double *y, double *gy)
 {
-    vpdsi_stream *st = &s->stream;
-    int d = s->dim, k;
+    const vpdsi_problem *pb = ctx->pb;
+    int d = pb->dim, k;
     size_t w = 1 + 2 * (size_t)d, children = (size_t)1 << d, j;
     double best = -1, extra = -1; /* extra: bounds of boxes no longer searched */
-    double tol = s->domain ? VPDS_STREAM_DOMAIN_TOLERANCE : VPDS_STREAM_TOLERANCE;
+    double tol = ctx->dom->fn ? VPDS_STREAM_DOMAIN_TOLERANCE : VPDS_STREAM_TOLERANCE;
     long splits;
     double g1, ub1, cs[(1u << VPDS_MAX_DIM) * VPDS_MAX_DIM], gs[1u << VPDS_MAX_DIM],
         ubs[1u << VPDS_MAX_DIM], mag = 0;
     vpds_status e;
     for (k = 0; k < d; k++) {
-        double m = fabs(s->lo[k]) > fabs(s->hi[k]) ? fabs(s->lo[k]) : fabs(s->hi[k]);
-        if (s->hi[k] - s->lo[k] > m) m = s->hi[k] - s->lo[k];
+        double m = fabs(pb->lo[k]) > fabs(pb->hi[k]) ? fabs(pb->lo[k]) : fabs(pb->hi[k]);
+        if (pb->hi[k] - pb->lo[k] > m) m = pb->hi[k] - pb->lo[k];
         if (m > mag) mag = m;
     }
-    if ((e = eval_boxes(s, centre, 1, half, &g1, &ub1)) != VPDS_OK) return e;
+    if ((e = eval_boxes(sm, ctx, centre, 1, half, &g1, &ub1)) != VPDS_OK) return e;
     best = g1;
     memcpy(y, centre, (size_t)d * sizeof(double));
-    st->n_boxes = 0;
-    if (vpdsi_mem_reserve(&s->mem, (void **)&st->boxes, &st->cap_boxes, w, sizeof(double))) goto oom;
-    st->boxes[0] = ub1;
-    memcpy(st->boxes + 1, centre, (size_t)d * sizeof(double));
-    memcpy(st->boxes + 1 + d, half, (size_t)d * sizeof(double));
-    st->n_boxes = 1;
+    sm->n_boxes = 0;
+    if (vpdsi_mem_reserve(ctx->mem, (void **)&sm->boxes, &sm->cap_boxes, w, sizeof(double))) goto oom;
+    sm->boxes[0] = ub1;
+    memcpy(sm->boxes + 1, centre, (size_t)d * sizeof(double));
+    memcpy(sm->boxes + 1 + d, half, (size_t)d * sizeof(double));
+    sm->n_boxes = 1;
     for (splits = 0;; splits++) {
         double top = -1, hb[VPDS_MAX_DIM], cb[VPDS_MAX_DIM], hmax = 0, U;
         size_t at = 0;
@@ -253,36 +252,36 @@ static vpds_status search_region(vpds_sampler *s, const double *centre, const do
              * resolve (a sliver the box centres miss) would otherwise keep the search going */
             char pc[256];
             vpdsi_format_point(pc, sizeof pc, centre, d);
-            vpdsi_set_error(s, "vpds_next: the search for the farthest point near (%s) did not "
+            vpdsi_store_error(ctx->st, "vpds_next: the search for the farthest point near (%s) did not "
                             "converge in %d box splits (a domain too thin for its signed distance"
                             " to resolve?)", pc, STREAM_SEARCH_BUDGET);
             return VPDS_ERR_DOMAIN;
         }
         /* the open boxes form a small list; a linear scan finds the best (they are few) */
-        for (j = 0; j < st->n_boxes; j++)
-            if (st->boxes[j * w] > top) {
-                top = st->boxes[j * w];
+        for (j = 0; j < sm->n_boxes; j++)
+            if (sm->boxes[j * w] > top) {
+                top = sm->boxes[j * w];
                 at = j;
             }
         U = top;
         if (best > U) U = best;
         if (extra > U) U = extra;
-        if (best < 0 && (U < 0 || st->n_boxes == 0)) {
+        if (best < 0 && (U < 0 || sm->n_boxes == 0)) {
             /* no point of the domain in the region (or none found above the precision) */
             *bound = 0;
             *gy = -1;
             return VPDS_OK;
         }
-        if (U <= best * (1 + tol) || st->n_boxes == 0) {
+        if (U <= best * (1 + tol) || sm->n_boxes == 0) {
             *bound = U;
             *gy = best;
             return VPDS_OK;
         }
         /* take the best box out, split it in 2^d */
-        memcpy(cb, st->boxes + at * w + 1, (size_t)d * sizeof(double));
-        memcpy(hb, st->boxes + at * w + 1 + d, (size_t)d * sizeof(double));
-        memmove(st->boxes + at * w, st->boxes + (st->n_boxes - 1) * w, w * sizeof(double));
-        st->n_boxes--;
+        memcpy(cb, sm->boxes + at * w + 1, (size_t)d * sizeof(double));
+        memcpy(hb, sm->boxes + at * w + 1 + d, (size_t)d * sizeof(double));
+        memmove(sm->boxes + at * w, sm->boxes + (sm->n_boxes - 1) * w, w * sizeof(double));
+        sm->n_boxes--;
         for (k = 0; k < d; k++) {
             hb[k] *= 0.5;
             if (hb[k] > hmax) hmax = hb[k];
@@ -292,16 +291,16 @@ static vpds_status search_region(vpds_sampler *s, const double *centre, const do
              * lies outside the domain: then what it holds of the domain is within the
              * precision of the boundary, covered up to it (as the box's delta) */
             double phi = 0;
-            if (s->domain && (e = vpdsi_domain_at(s, cb, &phi)) != VPDS_OK) return e;
+            if (ctx->dom->fn && (e = vpdsi_domain_at(ctx->dom, ctx->st, cb, &phi)) != VPDS_OK) return e;
             if (phi <= 0 && top > extra) extra = top;
             continue;
         }
         for (j = 0; j < children; j++)
             for (k = 0; k < d; k++)
                 cs[j * (size_t)d + (size_t)k] = cb[k] + ((j >> k) & 1u ? hb[k] : -hb[k]);
-        if ((e = eval_boxes(s, cs, children, hb, gs, ubs)) != VPDS_OK) return e;
-        if (vpdsi_mem_reserve(&s->mem, (void **)&st->boxes, &st->cap_boxes,
-                              (st->n_boxes + children) * w, sizeof(double)))
+        if ((e = eval_boxes(sm, ctx, cs, children, hb, gs, ubs)) != VPDS_OK) return e;
+        if (vpdsi_mem_reserve(ctx->mem, (void **)&sm->boxes, &sm->cap_boxes,
+                              (sm->n_boxes + children) * w, sizeof(double)))
             goto oom;
         for (j = 0; j < children; j++) {
             if (gs[j] > best) {
@@ -317,14 +316,14 @@ static vpds_status search_region(vpds_sampler *s, const double *centre, const do
                 if (ubs[j] > extra) extra = ubs[j];
                 continue;
             }
-            r = st->boxes + st->n_boxes++ * w;
+            r = sm->boxes + sm->n_boxes++ * w;
             r[0] = ubs[j];
             memcpy(r + 1, cs + j * (size_t)d, (size_t)d * sizeof(double));
             memcpy(r + 1 + d, hb, (size_t)d * sizeof(double));
         }
     }
 oom:
-    vpdsi_set_error(s, "out of memory in the stream's search");
+    vpdsi_store_error(ctx->st, "out of memory in the stream's search");
     return VPDS_ERR_OUT_OF_MEMORY;
 }
 
@@ -333,17 +332,19 @@ oom:
 
 /* Two radii: a point drawn uniformly from those free at t * inhibition whose coverage disk
  * at t holds y (rejection from the cube around y); y itself if the draws keep failing. */
-static vpds_status draw_near(vpds_sampler *s, double t, const double *y, double ry, double *x,
+static vpds_status draw_near(const vpdsi_ctx *ctx, double t, const double *y, double ry, double *x,
                              double *rx)
 {
-    int d = s->dim, k;
-    int uses_x = s->rule == VPDS_RULE_PRIOR || s->rule == VPDS_RULE_BIGGER;
-    double sl = t * s->coverage * s->sizing.lipschitz, rho, diag2 = 0;
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_store *st = ctx->st;
+    int d = pb->dim, k;
+    int uses_x = vpdsi_rule_may_exceed_ry(pb->rule);
+    double sl = t * pb->coverage * st->sizing.lipschitz, rho, diag2 = 0;
     vpdsi_kd_samples v;
     long tries, max_tries = 64L << d;
     vpds_status e;
-    for (k = 0; k < d; k++) diag2 += (s->hi[k] - s->lo[k]) * (s->hi[k] - s->lo[k]);
-    rho = t * s->coverage * ry;
+    for (k = 0; k < d; k++) diag2 += (pb->hi[k] - pb->lo[k]) * (pb->hi[k] - pb->lo[k]);
+    rho = t * pb->coverage * ry;
     if (uses_x) rho = sl < 1 ? rho / (1 - sl) : sqrt(diag2);
     if (rho * rho > diag2) rho = sqrt(diag2);
     for (tries = 0; tries < max_tries; tries++) {
@@ -351,26 +352,26 @@ static vpds_status draw_near(vpds_sampler *s, double t, const double *y, double 
         int32_t w, hit;
         int outside = 0;
         for (k = 0; k < d; k++) {
-            double u = y[k] + (2 * vpdsi_rng_unit(&s->rng) - 1) * rho;
+            double u = y[k] + (2 * vpdsi_rng_unit(ctx->rng) - 1) * rho;
             d2 += (u - y[k]) * (u - y[k]);
-            if (s->period[k] == 0 && (u < s->lo[k] || u > s->hi[k])) outside = 1;
+            if (pb->period[k] == 0 && (u < pb->lo[k] || u > pb->hi[k])) outside = 1;
             x[k] = u;
         }
         if (outside || d2 > rho * rho) continue;
-        vpdsi_wrap_point(s, x);
-        if (s->domain) {
+        vpdsi_store_wrap(st, x);
+        if (ctx->dom->fn) {
             double phi;
-            if ((e = vpdsi_domain_at(s, x, &phi)) != VPDS_OK) return e;
+            if ((e = vpdsi_domain_at(ctx->dom, st, x, &phi)) != VPDS_OK) return e;
             if (phi > 0) continue;
         }
-        if ((e = vpdsi_radius_at(s, x, rx)) != VPDS_OK) return e;
-        f = t * s->coverage * vpdsi_rule_f(s->rule, *rx, ry);
+        if ((e = vpdsi_store_radius_at(st, x, rx)) != VPDS_OK) return e;
+        f = t * pb->coverage * vpdsi_rule_f(pb->rule, *rx, ry);
         if (d2 > f * f) continue; /* does not cover y */
-        v = vpdsi_samples_view(s);
-        hit = vpdsi_kd_conflict(&s->tree, &v, x, *rx, (int)s->rule, t * s->inhibition,
-                                s->sizing.kind == VPDSI_SIZING_CONSTANT ? -1.0 : s->sizing.lipschitz, &w);
+        v = vpdsi_store_view(st);
+        hit = vpdsi_kd_conflict(&st->tree, &v, x, *rx, (int)pb->rule, t * pb->inhibition,
+                                st->sizing.kind == VPDSI_SIZING_CONSTANT ? -1.0 : st->sizing.lipschitz, &w);
         if (hit == -2) {
-            vpdsi_set_error(s, "sizing breaks lipschitz = %g near sample %d", s->sizing.lipschitz, (int)w);
+            vpdsi_store_error(st, "sizing breaks lipschitz = %g near sample %d", st->sizing.lipschitz, (int)w);
             return VPDS_ERR_LIPSCHITZ;
         }
         if (hit == -1) return VPDS_OK;
@@ -380,16 +381,17 @@ static vpds_status draw_near(vpds_sampler *s, double t, const double *y, double 
     return VPDS_OK;
 }
 
-vpds_status vpdsi_stream_next(vpds_sampler *s, double t_min, double *x_out, double *t_out)
+vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_min, double t_cap, double *x_out, double *t_out)
 {
-    vpdsi_stream *st = &s->stream;
-    int d = s->dim, k;
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_store *st = ctx->st;
+    int d = pb->dim, k;
     uint64_t rec[3 + 2 * VPDS_MAX_DIM];
-    vpdsi_rng start = s->rng;
+    vpdsi_rng start = *ctx->rng;
     vpds_status e;
-    if ((e = vpdsi_sync_tree(s)) != VPDS_OK) return e;
-    if ((e = vpdsi_reserve_samples(s, 1)) != VPDS_OK) return e;
-    if (s->n == 0) {
+    if ((e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
+    if ((e = vpdsi_store_reserve(st, 1)) != VPDS_OK) return e;
+    if (st->n == 0) {
         /* the first sample: uniform over the box, at t = +infinity */
         double x[VPDS_MAX_DIM], r;
         long tries;
@@ -397,32 +399,32 @@ vpds_status vpdsi_stream_next(vpds_sampler *s, double t_min, double *x_out, doub
         for (tries = 0;; tries++) { /* uniform over the domain, by rejection from the box */
             double phi = 0;
             if (tries == STREAM_FIRST_TRIES) {
-                s->rng = start;
-                vpdsi_set_error(s, "domain: none of %d uniform points of the box has sdf <= 0 (the"
+                *ctx->rng = start;
+                vpdsi_store_error(st, "domain: none of %d uniform points of the box has sdf <= 0 (the"
                                 " domain is empty, or too small for a first sample)", STREAM_FIRST_TRIES);
                 return VPDS_ERR_DOMAIN;
             }
             for (k = 0; k < d; k++) {
-                double u = s->lo[k] + vpdsi_rng_unit(&s->rng) * (s->hi[k] - s->lo[k]);
-                x[k] = u > s->hi[k] ? s->hi[k] : u;
+                double u = pb->lo[k] + vpdsi_rng_unit(ctx->rng) * (pb->hi[k] - pb->lo[k]);
+                x[k] = u > pb->hi[k] ? pb->hi[k] : u;
             }
-            if (s->domain && (e = vpdsi_domain_at(s, x, &phi)) != VPDS_OK) {
-                s->rng = start;
+            if (ctx->dom->fn && (e = vpdsi_domain_at(ctx->dom, st, x, &phi)) != VPDS_OK) {
+                *ctx->rng = start;
                 return e;
             }
             if (phi <= 0) break;
         }
-        if ((e = vpdsi_radius_at(s, x, &r)) != VPDS_OK) {
-            s->rng = start;
+        if ((e = vpdsi_store_radius_at(st, x, &r)) != VPDS_OK) {
+            *ctx->rng = start;
             return e;
         }
-        vpdsi_append_sample(s, x, r, INFINITY, 0);
+        vpdsi_store_append(st, x, r, INFINITY, 0);
         memcpy(x_out, x, (size_t)d * sizeof(double));
         *t_out = INFINITY;
-        s->stats.accepted++;
+        ctx->stats->accepted++;
         return VPDS_OK;
     }
-    if (!st->active && (e = build_regions(s)) != VPDS_OK) return e;
+    if (!sm->active && (e = build_regions(sm, ctx)) != VPDS_OK) return e;
     /* The top region is read, not popped, until every callback of the step has answered: a
      * failing sizing or domain callback then leaves the heap as it was, record for record (a
      * pop and a push of the same record would reorder regions of equal keys, and a retry
@@ -434,39 +436,39 @@ vpds_status vpdsi_stream_next(vpds_sampler *s, double t_min, double *x_out, doub
         int resolved, event;
         unsigned level;
         uint64_t *c = rec + REC_COORD;
-        size_t w = rec_words(s);
-        key = rec_key(st->heap);
+        size_t w = rec_words(sm);
+        key = rec_key(sm->heap);
         if (key <= t_min) return VPDS_STREAM_END; /* every region is below: nothing consumed */
-        if (heap_reserve(s, (size_t)1 << d)) {
-            vpdsi_set_error(s, "out of memory for the stream's regions");
+        if (heap_reserve(sm, ctx->mem, (size_t)1 << d)) {
+            vpdsi_store_error(st, "out of memory for the stream's regions");
             return VPDS_ERR_OUT_OF_MEMORY;
         }
-        memcpy(rec, st->heap, w * sizeof(uint64_t));
+        memcpy(rec, sm->heap, w * sizeof(uint64_t));
         level = (unsigned)rec[1];
         memcpy(&gy, rec + 2, sizeof gy);
         memcpy(y, rec + REC_COORD + d, (size_t)d * sizeof(double));
         /* the largest key below the top's: one of its children's (the key the top would
          * have after a pop) */
-        next = st->count > 1 ? rec_key(st->heap + w) : 0.0;
-        if (st->count > 2 && rec_key(st->heap + 2 * w) > next) next = rec_key(st->heap + 2 * w);
-        region_box(s, level, c, centre, half);
+        next = sm->count > 1 ? rec_key(sm->heap + w) : 0.0;
+        if (sm->count > 2 && rec_key(sm->heap + 2 * w) > next) next = rec_key(sm->heap + 2 * w);
+        region_box(sm, level, c, centre, half);
         for (k = 0; k < d; k++) h += half[k] * half[k];
         h = sqrt(h);
-        if (isfinite(key) && level < st->max_level) {
+        if (isfinite(key) && level < sm->max_level) {
             /* too coarse for the scale of its key: hand its key to its 2^d children */
             double r;
-            if ((e = vpdsi_radius_at(s, centre, &r)) != VPDS_OK) return e;
-            if (h > STREAM_SPLIT * key * s->coverage * (r - s->sizing.lipschitz * h) ||
-                r <= s->sizing.lipschitz * h) {
+            if ((e = vpdsi_store_radius_at(st, centre, &r)) != VPDS_OK) return e;
+            if (h > STREAM_SPLIT * key * pb->coverage * (r - st->sizing.lipschitz * h) ||
+                r <= st->sizing.lipschitz * h) {
                 uint64_t b, cc[VPDS_MAX_DIM];
-                heap_pop(s, rec);
+                heap_pop(sm, rec);
                 for (b = 0; b < ((uint64_t)1 << d); b++) {
                     int skip = 0;
                     for (k = 0; k < d; k++) {
                         cc[k] = 2 * c[k] + ((b >> k) & 1u);
-                        if (cc[k] >= (st->n0[k] << (level + 1))) skip = 1;
+                        if (cc[k] >= (sm->geom.n0[k] << (level + 1))) skip = 1;
                     }
-                    if (!skip) heap_push(s, key, level + 1, cc, -1.0, NULL);
+                    if (!skip) heap_push(sm, key, level + 1, cc, -1.0, NULL);
                 }
                 continue;
             }
@@ -476,36 +478,36 @@ vpds_status vpdsi_stream_next(vpds_sampler *s, double t_min, double *x_out, doub
             /* the cached maximiser still holds if no sample since lowered g there: then the
              * region's bound is unchanged (samples only lower g) */
             double g1, ub1, zero[VPDS_MAX_DIM] = {0};
-            if ((e = eval_boxes(s, y, 1, zero, &g1, &ub1)) != VPDS_OK) return e;
+            if ((e = eval_boxes(sm, ctx, y, 1, zero, &g1, &ub1)) != VPDS_OK) return e;
             if (g1 == gy) {
                 resolved = 1;
                 bound = key;
             }
         }
-        if (!resolved && (e = search_region(s, centre, half, &bound, y, &gy)) != VPDS_OK) return e;
+        if (!resolved && (e = search_region(sm, ctx, centre, half, &bound, y, &gy)) != VPDS_OK) return e;
         /* an event at t = bound (an upper bound of max g), never above the scale at which the
          * set is already maximal (the last event's, or a run's) */
         event = bound >= next;
         if (event) {
             double ry;
             t = bound;
-            if (s->run.phase == VPDSI_DONE && t > s->run.t) t = s->run.t;
+            if (t > t_cap) t = t_cap;
             if (t > t_min) {
-                if ((e = vpdsi_radius_at(s, y, &ry)) != VPDS_OK) return e;
+                if ((e = vpdsi_store_radius_at(st, y, &ry)) != VPDS_OK) return e;
                 memcpy(x, y, (size_t)d * sizeof(double));
                 rx = ry;
-                if (s->two_radii && (e = draw_near(s, t, y, ry, x, &rx)) != VPDS_OK) {
-                    s->rng = start;
+                if (pb->two_radii && (e = draw_near(ctx, t, y, ry, x, &rx)) != VPDS_OK) {
+                    *ctx->rng = start;
                     return e;
                 }
             }
         }
-        heap_pop(s, rec);
-        heap_push(s, bound, level, c, gy, y);
+        heap_pop(sm, rec);
+        heap_push(sm, bound, level, c, gy, y);
         if (!event) continue;
         if (t <= t_min) return VPDS_STREAM_END;
-        vpdsi_append_sample(s, x, rx, t, 0);
-        s->stats.accepted++;
+        vpdsi_store_append(st, x, rx, t, 0);
+        ctx->stats->accepted++;
         memcpy(x_out, x, (size_t)d * sizeof(double));
         *t_out = t;
         return VPDS_OK;

@@ -1,15 +1,15 @@
 /* Continuous decrease (Section 4.2): the state of the one-sample-at-a-time stream. */
 #ifndef VPDS_STREAM_H
 #define VPDS_STREAM_H
-#include "mem.h"
+#include "cells.h"
+#include "context.h"
 
 /* The box is cut into regions (cells of a lazily refined grid) in a max-heap keyed by an upper
  * bound of g = distance to the samples over coverage * f, the scale at which a point becomes
  * covered. Samples only lower g, so a stale key stays an upper bound (DESIGN.md). */
 typedef struct vpdsi_stream {
     int active;                    /* regions built */
-    uint64_t n0[VPDS_MAX_DIM];     /* level-0 regions per axis */
-    double side0[VPDS_MAX_DIM];
+    vpdsi_lattice geom;            /* level-0 regions and their boxes */
     unsigned max_level;
     uint64_t *heap;                /* records of 2 + dim words: key (double), level, coordinates */
     size_t count, cap;
@@ -19,10 +19,11 @@ typedef struct vpdsi_stream {
     size_t cap_buf;
 } vpdsi_stream;
 
-struct vpds_sampler;
-
-void vpdsi_stream_init(vpdsi_stream *st);
-void vpdsi_stream_release(vpdsi_stream *st, vpdsi_mem *m);
-/* One event: the sample and its t, or VPDS_STREAM_END when t <= t_min (nothing consumed). */
-vpds_status vpdsi_stream_next(struct vpds_sampler *s, double t_min, double *x_out, double *t_out);
+void vpdsi_stream_init(vpdsi_stream *sm);
+void vpdsi_stream_release(vpdsi_stream *sm, vpdsi_mem *m);
+/* One event: the sample and its t, or VPDS_STREAM_END when t <= t_min (nothing consumed).
+ * t_cap: the scale at which the set is already maximal (a run's, or the last event's); no
+ * event is placed above it (+INFINITY: none). */
+vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_min, double t_cap,
+                              double *x_out, double *t_out);
 #endif

@@ -6,6 +6,7 @@
 #include "refuse.h"
 #include "rules.h"
 #include "sampler.h"
+#include "sizing.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -53,21 +54,12 @@ static vpds_status tiles_sizing_params(const vpds_tiling_desc *d, double *L, dou
         *L = s->lipschitz;
         *rmin = s->radius_min;
         *rmax = s->radius_max;
-    } else if (callback) {
-        if (!(s->radius_max > 0))
+    } else {
+        if (callback && !(s->radius_max > 0))
             VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.sampler->radius_max = %g: a tiling with a sizing "
                   "callback needs an upper bound of r (it sets the margin, the reach of a disk)",
                   s->radius_max);
-        *L = s->lipschitz;
-        *rmin = s->radius_min;
-        *rmax = s->radius_max;
-    } else if (s->sizing_grid) {
-        *L = s->lipschitz != VPDS_UNSET ? s->lipschitz : s->sizing_grid->lipschitz;
-        *rmin = s->sizing_grid->vmin;
-        *rmax = s->sizing_grid->vmax;
-    } else {
-        *L = 0;
-        *rmin = *rmax = s->radius;
+        vpdsi_sizing_bounds(s, L, rmin, rmax);
     }
     return VPDS_OK;
 }
@@ -98,7 +90,7 @@ vpds_status vpds_tiling_validate(const vpds_tiling_desc *d, char *msg, size_t ca
         VPDSI_REFUSE(VPDS_ERR_OVERFLOW, "tiling desc.scale = %g: scale * coverage must be within [1e-50, 1e50]",
               d->scale);
     if ((st = tiles_sizing_params(d, &L, &rmin, &rmax, msg, cap)) != VPDS_OK) return st;
-    rule = d->sampler->rule == VPDS_RULE_DEFAULT ? VPDS_RULE_SMALLER : d->sampler->rule;
+    rule = vpdsi_rule_resolve(d->sampler->rule);
     limit = vpdsi_rule_max_lipschitz(rule);
     if (d->scale * d->sampler->coverage * L >= limit)
         VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.scale = %g: scale * coverage * L = %g is at or above "
@@ -218,17 +210,10 @@ int vpds_tiling_phase(const vpds_tiling *t, uint64_t tile)
     return tiles_phase_of(t, c);
 }
 
-static uint64_t tiles_mix(uint64_t z)
-{
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
 uint64_t vpds_tiling_seed(const vpds_tiling *t, uint64_t tile)
 {
     if (!tiles_live(t)) return 0;
-    return tiles_mix(tiles_mix(t->desc.seed + 0x9E3779B97F4A7C15ull) + (tile + 1) * 0x9E3779B97F4A7C15ull);
+    return vpdsi_mix64(vpdsi_mix64(t->desc.seed + 0x9E3779B97F4A7C15ull) + (tile + 1) * 0x9E3779B97F4A7C15ull);
 }
 
 vpds_status vpds_tiling_coords(const vpds_tiling *t, uint64_t tile, uint64_t *coords)
@@ -629,14 +614,10 @@ vpds_status vpds_tile_create(const vpds_tiling *t, uint64_t tile, const vpds_til
                                  vpds_status_string(st));
         goto done;
     }
-    if (s->sizing.kind != VPDSI_SIZING_CONSTANT) {
-        /* every tile sees the whole sizing's bounds, whatever part of it it holds: the same cells
-         * and pruning as the batch, and a window gives the points of the whole grid */
-        s->sizing.lipschitz = t->lipschitz;
-        s->sizing.rmin = t->rmin;
-        s->sizing.rmax = t->rmax;
-    }
-    if (t->scale != 1.0) vpdsi_mps_reset(s, t->scale);
+    /* every tile sees the whole sizing's bounds, whatever part of it it holds: the same cells
+     * and pruning as the batch, and a window gives the points of the whole grid */
+    vpdsi_sampler_share_bounds(s, t->lipschitz, t->rmin, t->rmax);
+    if (t->scale != 1.0) vpdsi_sampler_start_at(s, t->scale);
 
     count = tiles_gather(t, c, dep, n_dep, order, deps, lo, hi, NULL, NULL);
     if (count) {

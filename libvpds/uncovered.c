@@ -5,7 +5,6 @@
  * kd-tree wraps them. The search reads candidate lists handed down from box to sub-box. */
 #include "uncovered.h"
 #include "rules.h"
-#include "sampler.h"
 #include "torus.h"
 #include <math.h>
 #include <string.h>
@@ -19,7 +18,7 @@
  * examines thousands of boxes, most of them deep and small. Instead each box keeps two lists
  * for its sub-boxes, filtered from its parent's: the uncovered-cell centres near it and the
  * samples that may matter inside it (kdtree.h, "Near"). Depth first, the parent of a box at
- * depth k is the last box examined at depth k - 1, so one slot per depth (in s->cand2) holds
+ * depth k is the last box examined at depth k - 1, so one slot per depth (in u->lists) holds
  * them. The tests read the lists with the kd-tree's own per-sample arithmetic: same answers. */
 typedef struct {
     int u_ok, s_ok;  /* the list is complete (else the box's tests read the kd-tree) */
@@ -28,7 +27,10 @@ typedef struct {
 } bb_lists;
 
 typedef struct {
-    vpds_sampler *s;
+    vpdsi_uncovered *u;
+    const vpdsi_problem *pb;
+    vpdsi_store *st;
+    vpdsi_domain *dom;
     const double *alo, *ahi;
     double centre[VPDS_MAX_DIM];
     double r_anchor, scale, L, reach, slack;
@@ -43,64 +45,83 @@ typedef struct {
     int32_t w;
 } bb_search;
 
-double vpdsi_coverage_reach(const vpds_sampler *s, double r_hi)
+void vpdsi_uncovered_init(vpdsi_uncovered *u, int dim, const double *period)
 {
-    double scale = s->run.t * s->coverage, sl = scale * s->sizing.lipschitz;
-    int uses_u = s->rule == VPDS_RULE_CURRENT || s->rule == VPDS_RULE_BIGGER;
-    if (!uses_u) return scale * r_hi;
-    return sl < 1 ? scale * r_hi / (1 - sl) : INFINITY;
+    memset(u, 0, sizeof *u);
+    vpdsi_kd_init(&u->tree, dim);
+    vpdsi_kd_set_period(&u->tree, period);
 }
 
-vpds_status vpdsi_uncovered_index(vpds_sampler *s)
+void vpdsi_uncovered_release(vpdsi_uncovered *u, vpdsi_mem *m)
 {
-    const vpdsi_run *run = &s->run;
-    int d = s->dim, k;
+    vpdsi_mem_free(m, u->flag, u->cap_flag);
+    vpdsi_kd_release(&u->tree, m);
+    vpdsi_mem_free(m, u->x, u->cap_x * sizeof(double));
+    vpdsi_mem_free(m, u->r, u->cap_r * sizeof(double));
+    vpdsi_mem_free(m, u->f, u->cap_f);
+    vpdsi_mem_free(m, u->lists, u->cap_lists * sizeof(int32_t));
+    vpdsi_mem_free(m, u->stack, u->cap_stack * sizeof(double));
+    u->flag = u->f = NULL;
+    u->x = u->r = u->stack = NULL;
+    u->lists = NULL;
+    u->cap_flag = u->cap_x = u->cap_r = u->cap_f = u->cap_lists = u->cap_stack = 0;
+    u->ready = 0;
+}
+
+static vpdsi_kd_samples centres_view(const vpdsi_uncovered *u)
+{
+    vpdsi_kd_samples v;
+    v.x = u->x;
+    v.r = u->r;
+    v.flags = u->f;
+    return v;
+}
+
+vpds_status vpdsi_uncovered_index(vpdsi_uncovered *u, vpdsi_store *st, const vpdsi_cells *next,
+                                  const vpdsi_lattice *g)
+{
+    int d = g->dim, k;
     size_t i, m = 0, nx;
     uint64_t c[VPDS_MAX_DIM];
     vpdsi_kd_samples v;
-    s->u_ready = 0;
-    for (i = 0; i < run->next.count; i++) m += s->next_u[i] != 0;
+    u->ready = 0;
+    for (i = 0; i < next->count; i++) m += u->flag[i] != 0;
     if (vpdsi_mul_size(m + 1, (size_t)d, &nx) ||
-        vpdsi_mem_reserve(&s->mem, (void **)&s->ux, &s->cap_ux, nx, sizeof(double)) ||
-        vpdsi_mem_reserve(&s->mem, (void **)&s->ur, &s->cap_ur, m + 1, sizeof(double)) ||
-        vpdsi_mem_reserve(&s->mem, (void **)&s->uf, &s->cap_uf, m + 1, 1)) {
-        vpdsi_set_error(s, "out of memory indexing %zu uncovered cells", m);
+        vpdsi_mem_reserve(st->mem, (void **)&u->x, &u->cap_x, nx, sizeof(double)) ||
+        vpdsi_mem_reserve(st->mem, (void **)&u->r, &u->cap_r, m + 1, sizeof(double)) ||
+        vpdsi_mem_reserve(st->mem, (void **)&u->f, &u->cap_f, m + 1, 1)) {
+        vpdsi_store_error(st, "out of memory indexing %zu uncovered cells", m);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
-    vpdsi_kd_clear(&s->utree);
-    if (vpdsi_kd_reserve(&s->utree, &s->mem, m + 1, m + 1)) {
-        vpdsi_set_error(s, "out of memory indexing %zu uncovered cells", m);
+    vpdsi_kd_clear(&u->tree);
+    if (vpdsi_kd_reserve(&u->tree, st->mem, m + 1, m + 1)) {
+        vpdsi_store_error(st, "out of memory indexing %zu uncovered cells", m);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
-    s->u_half = 0;
-    v.x = s->ux;
-    v.r = s->ur;
-    v.flags = s->uf;
-    for (i = 0, m = 0; i < run->next.count; i++) {
+    u->half = 0;
+    v = centres_view(u);
+    for (i = 0, m = 0; i < next->count; i++) {
         double half2, lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
-        if (!s->next_u[i]) continue;
-        vpdsi_cells_get(&run->next, i, d, c);
-        half2 = 0.25 * vpdsi_cell_box(s, run->next.level, c, lo, hi);
-        for (k = 0; k < d; k++) s->ux[m * (size_t)d + (size_t)k] = 0.5 * (lo[k] + hi[k]);
-        if (sqrt(half2) > s->u_half) s->u_half = sqrt(half2);
-        s->ur[m] = 1.0;
-        s->uf[m] = 0;
-        vpdsi_kd_insert(&s->utree, &v, (int32_t)m);
+        if (!u->flag[i]) continue;
+        vpdsi_cells_get(next, i, d, c);
+        half2 = 0.25 * vpdsi_lattice_box(g, next->level, c, lo, hi);
+        for (k = 0; k < d; k++) u->x[m * (size_t)d + (size_t)k] = 0.5 * (lo[k] + hi[k]);
+        if (sqrt(half2) > u->half) u->half = sqrt(half2);
+        u->r[m] = 1.0;
+        u->f[m] = 0;
+        vpdsi_kd_insert(&u->tree, &v, (int32_t)m);
         m++;
     }
-    s->u_ready = 1;
+    u->ready = 1;
     return VPDS_OK;
 }
 
-double vpdsi_uncovered_nearest(const vpds_sampler *s, const double *p)
+double vpdsi_uncovered_nearest(const vpdsi_uncovered *u, const double *p)
 {
-    vpdsi_kd_samples v;
+    vpdsi_kd_samples v = centres_view(u);
     int32_t arg;
-    if (!s->u_ready) return 0.0;
-    v.x = s->ux;
-    v.r = s->ur;
-    v.flags = s->uf;
-    return vpdsi_kd_min_ratio(&s->utree, &v, p, 0.0, 1.0, (int)VPDS_RULE_PRIOR, &arg);
+    if (!u->ready) return 0.0;
+    return vpdsi_kd_min_ratio(&u->tree, &v, p, 0.0, 1.0, (int)VPDS_RULE_PRIOR, &arg);
 }
 
 static size_t slot(int depth, int samples)
@@ -109,26 +130,25 @@ static size_t slot(int depth, int samples)
 }
 
 /* Whether a cell that may hold an uncovered point lies within thr of c2: exactly
- * vpdsi_uncovered_nearest(s, c2) <= thr, read from this box's list of centres when complete. */
+ * vpdsi_uncovered_nearest(q->u, c2) <= thr, read from this box's list of centres when complete. */
 static int near_uncovered(bb_search *q, int depth, const double *c2, double thr)
 {
-    vpds_sampler *s = q->s;
     bb_lists *me = &q->lv[depth];
     size_t off = slot(depth, 0);
     q->count = off;
     if (q->lists && depth > 0 && q->lv[depth - 1].u_ok) {
-        me->u_n = vpdsi_kd_filter_near(&s->utree, &q->uview, s->cand2 + slot(depth - 1, 0),
+        me->u_n = vpdsi_kd_filter_near(&q->u->tree, &q->uview, q->u->lists + slot(depth - 1, 0),
                                        q->lv[depth - 1].u_n, c2, c2, 0.0, thr, q->slack,
-                                       s->cand2 + off);
+                                       q->u->lists + off);
         me->u_ok = 1;
-    } else if (q->lists && vpdsi_kd_near_box(&s->utree, &q->uview, c2, c2, 0.0, thr, q->slack,
-                                             LIST_CAP, &s->mem, &s->cand2, &q->count,
-                                             &s->cap_cand2) == 0) {
+    } else if (q->lists && vpdsi_kd_near_box(&q->u->tree, &q->uview, c2, c2, 0.0, thr, q->slack,
+                                             LIST_CAP, q->st->mem, &q->u->lists, &q->count,
+                                             &q->u->cap_lists) == 0) {
         me->u_n = q->count - off;
         me->u_ok = 1;
     }
-    if (!me->u_ok) return !(vpdsi_uncovered_nearest(s, c2) > thr);
-    return !(vpdsi_kd_list_min_ratio(&s->utree, &q->uview, s->cand2 + off, me->u_n, c2, 0.0, 1.0,
+    if (!me->u_ok) return !(vpdsi_uncovered_nearest(q->u, c2) > thr);
+    return !(vpdsi_kd_list_min_ratio(&q->u->tree, &q->uview, q->u->lists + off, me->u_n, c2, 0.0, 1.0,
                                      (int)VPDS_RULE_PRIOR) > thr);
 }
 
@@ -138,12 +158,11 @@ static int near_uncovered(bb_search *q, int depth, const double *c2, double thr)
 static void sample_list(bb_search *q, int depth, const double *lo, const double *hi, double rp,
                         double r_hi, double diag)
 {
-    vpds_sampler *s = q->s;
     bb_lists *me = &q->lv[depth], *up = depth > 0 ? &q->lv[depth - 1] : NULL;
     size_t off = slot(depth, 1);
     double rb = r_hi + q->L * diag;
     if (!q->lists) return;
-    if (s->tree.n_nodes == 0) { /* no sample: the empty list is complete for any r */
+    if (q->st->tree.n_nodes == 0) { /* no sample: the empty list is complete for any r */
         me->s_n = 0;
         me->s_ok = 1;
         me->r_bound = INFINITY;
@@ -151,12 +170,12 @@ static void sample_list(bb_search *q, int depth, const double *lo, const double 
     }
     if (up && up->s_ok && rp <= up->r_bound && r_hi <= up->r_bound) {
         if (rb > up->r_bound) rb = up->r_bound;
-        me->s_n = vpdsi_kd_filter_near(&s->tree, &q->view, s->cand2 + slot(depth - 1, 1), up->s_n,
-                                       lo, hi, rb, q->scale, q->slack, s->cand2 + off);
+        me->s_n = vpdsi_kd_filter_near(&q->st->tree, &q->view, q->u->lists + slot(depth - 1, 1), up->s_n,
+                                       lo, hi, rb, q->scale, q->slack, q->u->lists + off);
         me->s_ok = 1;
     } else if ((q->count = off,
-                vpdsi_kd_near_box(&s->tree, &q->view, lo, hi, rb, q->scale, q->slack, LIST_CAP,
-                                  &s->mem, &s->cand2, &q->count, &s->cap_cand2)) == 0) {
+                vpdsi_kd_near_box(&q->st->tree, &q->view, lo, hi, rb, q->scale, q->slack, LIST_CAP,
+                                  q->st->mem, &q->u->lists, &q->count, &q->u->cap_lists)) == 0) {
         me->s_n = q->count - off;
         me->s_ok = 1;
     }
@@ -166,35 +185,33 @@ static void sample_list(bb_search *q, int depth, const double *lo, const double 
 /* Whether a sample covers p at t * coverage (vpdsi_kd_conflict, from the list when complete). */
 static int p_covered(bb_search *q, int depth, const double *p, double rp)
 {
-    vpds_sampler *s = q->s;
     if (q->lv[depth].s_ok)
         return q->lv[depth].s_n > 0 &&
-               vpdsi_kd_list_conflict(&s->tree, &q->view, s->cand2 + slot(depth, 1),
-                                      q->lv[depth].s_n, p, rp, (int)s->rule, q->scale);
-    return vpdsi_kd_conflict(&s->tree, &q->view, p, rp, (int)s->rule, q->scale, -1.0, &q->w) != -1;
+               vpdsi_kd_list_conflict(&q->st->tree, &q->view, q->u->lists + slot(depth, 1),
+                                      q->lv[depth].s_n, p, rp, (int)q->pb->rule, q->scale);
+    return vpdsi_kd_conflict(&q->st->tree, &q->view, p, rp, (int)q->pb->rule, q->scale, -1.0, &q->w) != -1;
 }
 
 /* Whether one sample covers the whole box, r_lo <= r <= r_hi over it (gather, then the test). */
 static vpds_status search_box_covered(bb_search *q, int depth, const double *lo, const double *hi,
                                double r_lo, double r_hi, int *covered)
 {
-    vpds_sampler *s = q->s;
     size_t off = q->lists ? LIST_SLOTS : 0;
     if (q->lv[depth].s_ok) {
         *covered = r_lo > 0 && q->lv[depth].s_n > 0 &&
-                   vpdsi_kd_list_box_covered(&s->tree, &q->view, s->cand2 + slot(depth, 1),
-                                             q->lv[depth].s_n, lo, hi, r_hi, r_lo, (int)s->rule,
+                   vpdsi_kd_list_box_covered(&q->st->tree, &q->view, q->u->lists + slot(depth, 1),
+                                             q->lv[depth].s_n, lo, hi, r_hi, r_lo, (int)q->pb->rule,
                                              q->scale);
         return VPDS_OK;
     }
-    s->n_cand2 = off;
-    if (vpdsi_kd_gather(&s->tree, &q->view, lo, hi, r_hi, (int)s->rule, q->scale, 0, &s->mem,
-                        &s->cand2, &s->n_cand2, &s->cap_cand2)) {
-        vpdsi_set_error(s, "out of memory gathering the samples near a box");
+    q->u->n_lists = off;
+    if (vpdsi_kd_gather(&q->st->tree, &q->view, lo, hi, r_hi, (int)q->pb->rule, q->scale, 0, q->st->mem,
+                        &q->u->lists, &q->u->n_lists, &q->u->cap_lists)) {
+        vpdsi_store_error(q->st, "out of memory gathering the samples near a box");
         return VPDS_ERR_OUT_OF_MEMORY;
     }
-    *covered = r_lo > 0 && vpdsi_kd_box_covered(&s->tree, &q->view, s->cand2 + off,
-                                                s->n_cand2 - off, lo, hi, r_lo, (int)s->rule,
+    *covered = r_lo > 0 && vpdsi_kd_box_covered(&q->st->tree, &q->view, q->u->lists + off,
+                                                q->u->n_lists - off, lo, hi, r_lo, (int)q->pb->rule,
                                                 q->scale);
     return VPDS_OK;
 }
@@ -204,8 +221,7 @@ static vpds_status search_box_covered(bb_search *q, int depth, const double *lo,
 static vpds_status examine(bb_search *q, const double *lo, const double *hi, int depth,
                            int *verdict)
 {
-    vpds_sampler *s = q->s;
-    int d = s->dim, k, in_region;
+    int d = q->pb->dim, k, in_region;
     double *p = q->p, *c2 = q->c2, gap2 = 0, diag2 = 0, diag, r_lo, r_hi;
     vpds_status st;
     *verdict = 0;
@@ -221,21 +237,21 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
     }
     if (gap2 > q->reach * q->reach) return VPDS_OK; /* misses the region */
     /* no cell that may hold an uncovered point meets the box */
-    if (s->u_ready && !near_uncovered(q, depth, c2, 0.5 * sqrt(diag2) + s->u_half)) return VPDS_OK;
+    if (q->u->ready && !near_uncovered(q, depth, c2, 0.5 * sqrt(diag2) + q->u->half)) return VPDS_OK;
     /* the box lies outside the domain: nothing there needs covering */
-    if (s->domain) {
-        if ((st = vpdsi_domain_at(s, c2, &q->phi)) != VPDS_OK) return st;
+    if (q->dom->fn) {
+        if ((st = vpdsi_domain_at(q->dom, q->st, c2, &q->phi)) != VPDS_OK) return st;
         if (q->phi > 0.5 * sqrt(diag2)) return VPDS_OK;
     }
-    if (s->sizing.kind == VPDSI_SIZING_CONSTANT)
-        q->rp = s->sizing.radius; /* what vpdsi_radius_at answers, without its frame */
-    else if ((st = vpdsi_radius_at(s, p, &q->rp)) != VPDS_OK)
+    if (q->st->sizing.kind == VPDSI_SIZING_CONSTANT)
+        q->rp = q->st->sizing.radius; /* what vpdsi_radius_at answers, without its frame */
+    else if ((st = vpdsi_store_radius_at(q->st, p, &q->rp)) != VPDS_OK)
         return st;
     diag = sqrt(diag2);
     r_lo = q->rp - q->L * diag;
     r_hi = q->rp + q->L * diag;
     if (q->point) {
-        double f = q->scale * vpdsi_rule_f(s->rule, q->r_anchor, q->rp), d2 = 0;
+        double f = q->scale * vpdsi_rule_f(q->pb->rule, q->r_anchor, q->rp), d2 = 0;
         for (k = 0; k < d; k++) d2 += (p[k] - q->alo[k]) * (p[k] - q->alo[k]);
         in_region = d2 <= f * f;
         /* Version 2: the box's nearest point lies beyond f(r_anchor, r) for every r the box
@@ -244,7 +260,7 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
          * a dart accepted that covers nothing new: 90 of the 677 samples of a 3D run with
          * two radii and the bigger rule (tests/determinism.sh, configuration 7). */
         if (q->exact_region) {
-            double f_hi = q->scale * vpdsi_rule_f(s->rule, q->r_anchor, r_hi);
+            double f_hi = q->scale * vpdsi_rule_f(q->pb->rule, q->r_anchor, r_hi);
             if (d2 > f_hi * f_hi) return VPDS_OK;
         }
     } else {
@@ -260,7 +276,7 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
     if (in_region && !p_covered(q, depth, p, q->rp)) {
         /* p is uncovered: no sample within t*coverage*f of it; a witness if in the domain */
         q->phi = 0;
-        if (s->domain && (st = vpdsi_domain_at(s, p, &q->phi)) != VPDS_OK) return st;
+        if (q->dom->fn && (st = vpdsi_domain_at(q->dom, q->st, p, &q->phi)) != VPDS_OK) return st;
         if (q->phi <= 0) {
             *verdict = 1;
             return VPDS_OK;
@@ -278,69 +294,47 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
 
 /* Round-off allowance of the candidate lists: a few ulps of the largest coordinate a box or an
  * image of it can reach, with room to spare. */
-static double list_slack(const vpds_sampler *s, const double *lo, const double *hi)
+static double list_slack(const vpdsi_problem *pb, const double *lo, const double *hi)
 {
     double m = 0;
     int k;
-    for (k = 0; k < s->dim; k++) {
+    for (k = 0; k < pb->dim; k++) {
         double a = fabs(lo[k]) > fabs(hi[k]) ? fabs(lo[k]) : fabs(hi[k]);
-        if (a + s->period[k] > m) m = a + s->period[k];
+        if (a + pb->period[k] > m) m = a + pb->period[k];
     }
     return 1e-12 * m;
 }
 
-vpds_status vpdsi_uncovered_in(vpds_sampler *s, const double *alo, const double *ahi,
-                               double r_anchor, int *found)
+/* The search's first box: the anchor widened by the reach, clipped to the box on open axes
+ * (uncovered points lie in the box), at depth 0. */
+static void first_box(bb_search *q, double *bx)
 {
-    int d = s->dim, k;
-    unsigned children = 1u << d, b;
-    size_t top = 0, boxes = 0, stride = 2 * (size_t)d + 1, need;
-    bb_search q;
-    vpds_status st;
-    *found = 0;
-    q.s = s;
-    q.alo = alo;
-    q.ahi = ahi;
-    q.r_anchor = r_anchor;
-    q.scale = s->run.t * s->coverage;
-    q.L = s->sizing.lipschitz;
-    q.point = memcmp(alo, ahi, (size_t)d * sizeof(double)) == 0;
-    q.exact_region = s->algorithm >= 2;
-    /* largest reach of the region: r(u) <= r_anchor + L |u - a| and |u - a| <= scale r(u) */
-    q.reach = vpdsi_coverage_reach(s, r_anchor);
-    if (!(q.scale * q.L < 1)) {
-        *found = 1;
-        return VPDS_OK;
-    }
-    if (vpdsi_mul_size((size_t)UNCOVERED_DEPTH * children + 1, stride, &need) ||
-        vpdsi_mem_reserve(&s->mem, (void **)&s->bb_stack, &s->cap_bb_stack, need, sizeof(double))) {
-        vpdsi_set_error(s, "out of memory for the two-radii coverage search");
-        return VPDS_ERR_OUT_OF_MEMORY;
-    }
-    if ((st = vpdsi_sync_tree(s)) != VPDS_OK) return st;
-    /* without room for the lists every test reads the kd-trees, as fast as before them */
-    q.lists = vpdsi_mem_reserve(&s->mem, (void **)&s->cand2, &s->cap_cand2, LIST_SLOTS,
-                                sizeof(int32_t)) == 0;
+    const vpdsi_problem *pb = q->pb;
+    int d = pb->dim, k;
     for (k = 0; k < d; k++) {
-        double *bx = s->bb_stack;
-        double lo = alo[k] - q.reach, hi = ahi[k] + q.reach;
-        q.centre[k] = 0.5 * (alo[k] + ahi[k]);
-        if (s->period[k] == 0) { /* uncovered points lie in the box */
-            if (lo < s->lo[k]) lo = s->lo[k];
-            if (hi > s->hi[k]) hi = s->hi[k];
+        double lo = q->alo[k] - q->reach, hi = q->ahi[k] + q->reach;
+        q->centre[k] = 0.5 * (q->alo[k] + q->ahi[k]);
+        if (pb->period[k] == 0) {
+            if (lo < pb->lo[k]) lo = pb->lo[k];
+            if (hi > pb->hi[k]) hi = pb->hi[k];
         }
         bx[k] = lo;
         bx[d + k] = hi;
-        bx[2 * d] = 0;
     }
-    q.slack = list_slack(s, s->bb_stack, s->bb_stack + d);
-    top = 1;
-    q.view = vpdsi_samples_view(s);
-    q.uview.x = s->ux;
-    q.uview.r = s->ur;
-    q.uview.flags = s->uf;
+    bx[2 * d] = 0;
+}
+
+/* Depth first over the boxes from the first one: *found at the first "uncovered" verdict, or
+ * when the boxes exceed the budget. */
+static vpds_status search(bb_search *q, int *found)
+{
+    int d = q->pb->dim, k;
+    unsigned children = 1u << d, b;
+    size_t top = 1, boxes = 0, stride = 2 * (size_t)d + 1;
+    double *stack = q->u->stack;
+    vpds_status st;
     while (top > 0) {
-        double *bx = s->bb_stack + --top * stride, lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
+        double *bx = stack + --top * stride, lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
         int depth = (int)bx[2 * d], verdict;
         memcpy(lo, bx, (size_t)d * sizeof(double));
         memcpy(hi, bx + d, (size_t)d * sizeof(double));
@@ -348,14 +342,14 @@ vpds_status vpdsi_uncovered_in(vpds_sampler *s, const double *alo, const double 
             *found = 1;
             return VPDS_OK;
         }
-        if ((st = examine(&q, lo, hi, depth, &verdict)) != VPDS_OK) return st;
+        if ((st = examine(q, lo, hi, depth, &verdict)) != VPDS_OK) return st;
         if (verdict == 1) {
             *found = 1;
             return VPDS_OK;
         }
         if (verdict == 0) continue;
         for (b = 0; b < children; b++) {
-            double *cb = s->bb_stack + top++ * stride;
+            double *cb = stack + top++ * stride;
             for (k = 0; k < d; k++) {
                 double mid = 0.5 * (lo[k] + hi[k]);
                 cb[k] = (b >> k) & 1u ? mid : lo[k];
@@ -365,4 +359,47 @@ vpds_status vpdsi_uncovered_in(vpds_sampler *s, const double *alo, const double 
         }
     }
     return VPDS_OK;
+}
+
+vpds_status vpdsi_uncovered_in(vpdsi_uncovered *u, const vpdsi_ctx *ctx, double t,
+                               const double *alo, const double *ahi, double r_anchor, int *found)
+{
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_store *st = ctx->st;
+    int d = pb->dim;
+    size_t stride = 2 * (size_t)d + 1, need;
+    bb_search q;
+    vpds_status e;
+    *found = 0;
+    q.u = u;
+    q.pb = pb;
+    q.st = st;
+    q.dom = ctx->dom;
+    q.alo = alo;
+    q.ahi = ahi;
+    q.r_anchor = r_anchor;
+    q.scale = t * pb->coverage;
+    q.L = st->sizing.lipschitz;
+    q.point = memcmp(alo, ahi, (size_t)d * sizeof(double)) == 0;
+    q.exact_region = pb->algorithm >= 2;
+    /* largest reach of the region: r(u) <= r_anchor + L |u - a| and |u - a| <= scale r(u) */
+    q.reach = vpdsi_rule_reach(pb->rule, q.scale, q.L, r_anchor);
+    if (!(q.scale * q.L < 1)) {
+        *found = 1;
+        return VPDS_OK;
+    }
+    if (vpdsi_mul_size((size_t)UNCOVERED_DEPTH * (1u << d) + 1, stride, &need) ||
+        vpdsi_mem_reserve(st->mem, (void **)&u->stack, &u->cap_stack, need, sizeof(double))) {
+        vpdsi_store_error(st, "out of memory for the two-radii coverage search");
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    if ((e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
+    /* without room for the lists every test reads the kd-trees, as fast as before them */
+    q.lists = vpdsi_mem_reserve(st->mem, (void **)&u->lists, &u->cap_lists, LIST_SLOTS,
+                                sizeof(int32_t)) == 0;
+    first_box(&q, u->stack);
+    q.slack = list_slack(pb, u->stack, u->stack + d);
+    q.view = vpdsi_store_view(st);
+    q.uview = centres_view(u);
+    return search(&q, found);
 }

@@ -133,13 +133,13 @@ static progress_t progress_of(const vpds_sampler *s)
 {
     progress_t p;
     memset(&p, 0, sizeof p);
-    p.n = s->n;
+    p.n = s->store.n;
     p.heap = s->stream.count;
     p.darts = s->stats.darts;
-    p.pos = s->run.pos;
-    p.vpos = s->run.vpos;
-    p.cells = s->run.cur.count + s->run.next.count;
-    p.phase = (int)s->run.phase;
+    p.pos = s->mps.run.pos;
+    p.vpos = s->mps.run.vpos;
+    p.cells = s->mps.run.cur.count + s->mps.run.next.count;
+    p.phase = (int)s->mps.run.phase;
     return p;
 }
 

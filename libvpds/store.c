@@ -1,0 +1,205 @@
+#include "store.h"
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+void vpdsi_store_init(vpdsi_store *st, vpdsi_mem *mem, int dim, const double *lo,
+                      const double *hi, const double *period)
+{
+    int k;
+    memset(st, 0, sizeof *st);
+    st->mem = mem;
+    st->dim = dim;
+    for (k = 0; k < dim; k++) {
+        st->lo[k] = lo[k];
+        st->hi[k] = hi[k];
+        st->period[k] = period ? period[k] : 0.0;
+    }
+    st->sizing.dim = dim;
+    vpdsi_kd_init(&st->tree, dim);
+    vpdsi_kd_set_period(&st->tree, st->period);
+}
+
+void vpdsi_store_release(vpdsi_store *st)
+{
+    vpdsi_mem *m = st->mem;
+    vpdsi_bgrid_release(&st->grid, m);
+    vpdsi_kd_release(&st->tree, m);
+    vpdsi_mem_free(m, st->x, st->cap_x * sizeof(double));
+    vpdsi_mem_free(m, st->r, st->cap_r * sizeof(double));
+    vpdsi_mem_free(m, st->t, st->cap_t * sizeof(double));
+    vpdsi_mem_free(m, st->flags, st->cap_flags);
+    if (st->sizing.grid) vpds_grid_destroy(st->sizing.grid);
+    st->x = st->r = st->t = NULL;
+    st->flags = NULL;
+    st->sizing.grid = NULL;
+    st->n = st->n_fixed = st->tree_n = 0;
+}
+
+void vpdsi_store_error(vpdsi_store *st, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(st->err, sizeof st->err, fmt, ap);
+    va_end(ap);
+}
+
+vpdsi_kd_samples vpdsi_store_view(const vpdsi_store *st)
+{
+    vpdsi_kd_samples v;
+    v.x = st->x;
+    v.r = st->r;
+    v.flags = st->flags;
+    return v;
+}
+
+void vpdsi_store_wrap(const vpdsi_store *st, double *x)
+{
+    int k;
+    for (k = 0; k < st->dim; k++) {
+        double P = st->period[k];
+        if (P > 0 && (x[k] < st->lo[k] || x[k] >= st->hi[k])) {
+            x[k] = st->lo[k] + fmod(x[k] - st->lo[k], P);
+            if (x[k] < st->lo[k]) x[k] += P;
+            if (x[k] >= st->hi[k]) x[k] = st->lo[k];
+        }
+    }
+}
+
+vpds_status vpdsi_store_radius_at(vpdsi_store *st, const double *p, double *r)
+{
+    double q[VPDS_MAX_DIM];
+    if (st->sizing.kind == VPDSI_SIZING_CONSTANT) {
+        *r = st->sizing.radius;
+        return VPDS_OK;
+    }
+    memcpy(q, p, (size_t)st->dim * sizeof(double));
+    vpdsi_store_wrap(st, q);
+    return vpdsi_sizing_eval(&st->sizing, q, 1, r, st->err, sizeof st->err);
+}
+
+vpds_status vpdsi_store_radii(vpdsi_store *st, const double *x, size_t n, double *out)
+{
+    return vpdsi_sizing_eval(&st->sizing, x, n, out, st->err, sizeof st->err);
+}
+
+vpds_status vpdsi_store_reserve(vpdsi_store *st, size_t more)
+{
+    size_t need = st->n + more, nx;
+    vpdsi_mem *m = st->mem;
+    if (need < st->n || need > (size_t)INT32_MAX || vpdsi_mul_size(need, (size_t)st->dim, &nx)) {
+        vpdsi_store_error(st, "%zu samples would overflow the sample index (at most %d)", need,
+                          INT32_MAX);
+        return VPDS_ERR_OVERFLOW;
+    }
+    if (vpdsi_mem_reserve(m, (void **)&st->x, &st->cap_x, nx, sizeof(double)) ||
+        vpdsi_mem_reserve(m, (void **)&st->r, &st->cap_r, need, sizeof(double)) ||
+        vpdsi_mem_reserve(m, (void **)&st->t, &st->cap_t, need, sizeof(double)) ||
+        vpdsi_mem_reserve(m, (void **)&st->flags, &st->cap_flags, need, 1) ||
+        (!st->grid_mode && vpdsi_kd_reserve(&st->tree, m, need, need - st->tree_n))) {
+        vpdsi_store_error(st, "out of memory for %zu samples", need);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    return VPDS_OK;
+}
+
+vpds_status vpdsi_store_sync_tree(vpdsi_store *st)
+{
+    vpdsi_kd_samples v = vpdsi_store_view(st);
+    if (st->tree_n == st->n) return VPDS_OK;
+    if (vpdsi_kd_reserve(&st->tree, st->mem, st->n, st->n - st->tree_n)) {
+        vpdsi_store_error(st, "out of memory indexing %zu samples", st->n);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    while (st->tree_n < st->n) vpdsi_kd_insert(&st->tree, &v, (int32_t)st->tree_n++);
+    return VPDS_OK;
+}
+
+vpds_status vpdsi_store_use_tree(vpdsi_store *st)
+{
+    vpds_status e = vpdsi_store_sync_tree(st);
+    if (e != VPDS_OK) return e;
+    if (st->grid_mode) {
+        st->grid_mode = 0;
+        vpdsi_bgrid_release(&st->grid, st->mem);
+    }
+    return VPDS_OK;
+}
+
+void vpdsi_store_append(vpdsi_store *st, const double *x, double r, double t, uint8_t flags)
+{
+    memcpy(st->x + st->n * (size_t)st->dim, x, (size_t)st->dim * sizeof(double));
+    st->r[st->n] = r;
+    st->t[st->n] = t;
+    st->flags[st->n] = flags;
+    st->n++;
+    if (st->grid_mode) {
+        st->grid.cell[vpdsi_bgrid_locate(&st->grid, x)] = (int32_t)(st->n - 1);
+    } else {
+        vpdsi_kd_samples v = vpdsi_store_view(st);
+        vpdsi_kd_insert(&st->tree, &v, (int32_t)(st->n - 1));
+        st->tree_n = st->n;
+    }
+}
+
+int vpdsi_store_has_samples(const vpdsi_store *st)
+{
+    size_t i;
+    for (i = 0; i < st->n; i++)
+        if (!(st->flags[i] & VPDSI_SAMPLE_FIXED)) return 1;
+    return 0;
+}
+
+/* A step coprime with n near n / phi: sorted input then cannot make the kd-tree a list. */
+static size_t scatter_step(size_t n)
+{
+    size_t step = n > 2 ? (size_t)(0.6180339887498949 * (double)n) | 1u : 1;
+    while (n > 2 && step > 1) {
+        size_t a = n, b = step;
+        while (b) { size_t tmp = a % b; a = b; b = tmp; }
+        if (a == 1) break;
+        step += 2;
+    }
+    return step;
+}
+
+vpds_status vpdsi_store_add_fixed(vpdsi_store *st, const double *x, const double *r, size_t n)
+{
+    size_t i, pos, step, first = st->n, dim = (size_t)st->dim;
+    double *radii = NULL;
+    vpdsi_kd_samples v;
+    vpds_status e;
+    /* fixed points may share cells and carry other radii: the kd-tree takes over, and it must
+     * first hold every sample (it lags after a run on the background grid) */
+    if ((e = vpdsi_store_use_tree(st)) != VPDS_OK) return e;
+    if ((e = vpdsi_store_reserve(st, n)) != VPDS_OK) return e;
+    if (!r) {
+        /* every radius first, so that a bad one leaves the store unchanged */
+        if (!(radii = (double *)vpdsi_mem_alloc(st->mem, n * sizeof(double)))) {
+            vpdsi_store_error(st, "out of memory for %zu radii", n);
+            return VPDS_ERR_OUT_OF_MEMORY;
+        }
+        if ((e = vpdsi_store_radii(st, x, n, radii)) != VPDS_OK) {
+            vpdsi_mem_free(st->mem, radii, n * sizeof(double));
+            return e;
+        }
+    }
+    for (i = 0; i < n; i++) {
+        double *xi = st->x + (first + i) * dim;
+        memcpy(xi, x + i * dim, dim * sizeof(double));
+        vpdsi_store_wrap(st, xi); /* on a periodic axis: its image inside the box */
+        st->r[first + i] = r ? r[i] : radii[i];
+        st->t[first + i] = INFINITY;
+        st->flags[first + i] = (uint8_t)(VPDSI_SAMPLE_FIXED | (r ? VPDSI_SAMPLE_OWN_RADIUS : 0u));
+    }
+    if (radii) vpdsi_mem_free(st->mem, radii, n * sizeof(double));
+    st->n += n;
+    v = vpdsi_store_view(st);
+    step = scatter_step(n);
+    for (i = 0, pos = 0; i < n; i++, pos = (pos + step) % n)
+        vpdsi_kd_insert(&st->tree, &v, (int32_t)(first + pos));
+    st->tree_n = st->n;
+    st->n_fixed += n;
+    return VPDS_OK;
+}

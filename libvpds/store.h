@@ -1,0 +1,60 @@
+/* The sample store: the samples in insertion order (points, radii, scales, flags), the index
+ * that answers proximity questions about them (kd-tree, or the background grid for a uniform
+ * radius), the radius at a point, the periodic wrap, and the error sink every layer writes to.
+ * The algorithms call down into it; it calls only the leaves. */
+#ifndef VPDS_STORE_H
+#define VPDS_STORE_H
+#include "bgrid.h"
+#include "kdtree.h"
+#include "sizing.h"
+
+typedef struct vpdsi_store {
+    vpdsi_mem *mem;                /* the sampler's allocator */
+    int dim;
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
+    double period[VPDS_MAX_DIM];   /* box side on a periodic axis, 0 on an open one */
+    vpdsi_sizing sizing;
+    size_t n, n_fixed;
+    double *x; size_t cap_x;
+    double *r; size_t cap_r;
+    double *t; size_t cap_t;
+    uint8_t *flags; size_t cap_flags;
+    vpdsi_kdtree tree;   /* holds samples [0, tree_n); synced before kd-tree queries */
+    size_t tree_n;
+    vpdsi_bgrid grid;    /* the uniform-radius accelerator, in use when grid_mode */
+    int grid_mode;
+    char err[512];
+} vpdsi_store;
+
+/* An empty store over the box [lo, hi] (period may be NULL: no periodic axis); the sizing is
+ * filled by the caller. */
+void vpdsi_store_init(vpdsi_store *st, vpdsi_mem *mem, int dim, const double *lo,
+                      const double *hi, const double *period);
+void vpdsi_store_release(vpdsi_store *st);
+void vpdsi_store_error(vpdsi_store *st, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* Replace coordinates outside the box on periodic axes by their image inside. */
+void vpdsi_store_wrap(const vpdsi_store *st, double *x);
+/* r at a point, wrapped into the box on periodic axes (where the sizing is defined). */
+vpds_status vpdsi_store_radius_at(vpdsi_store *st, const double *p, double *r);
+/* r at n points (unwrapped), errors said in the store's sink. */
+vpds_status vpdsi_store_radii(vpdsi_store *st, const double *x, size_t n, double *out);
+/* Room for `more` samples in every per-sample array and the tree; nothing changes on failure. */
+vpds_status vpdsi_store_reserve(vpdsi_store *st, size_t more);
+/* Insert samples [tree_n, n) into the kd-tree (before kd-tree queries after grid mode). */
+vpds_status vpdsi_store_sync_tree(vpdsi_store *st);
+/* Append and index a sample (after vpdsi_store_reserve). */
+void vpdsi_store_append(vpdsi_store *st, const double *x, double r, double t, uint8_t flags);
+/* Leave grid mode: the kd-tree takes over (it must hold every sample first). */
+vpds_status vpdsi_store_use_tree(vpdsi_store *st);
+/* Fixed points (vpds_add_points, after its checks): stored in the caller's order, each wrapped
+ * into the box on periodic axes, with radius r[i] or, r NULL, the sizing's; nothing changes
+ * on failure. The kd-tree takes over from the grid. */
+vpds_status vpdsi_store_add_fixed(vpdsi_store *st, const double *x, const double *r, size_t n);
+vpdsi_kd_samples vpdsi_store_view(const vpdsi_store *st);
+/* Whether a sample not added as a fixed point exists. */
+int vpdsi_store_has_samples(const vpdsi_store *st);
+#endif
