@@ -225,16 +225,14 @@ static void keep_darts_before(vpdsi_mps *m, const vpdsi_ctx *ctx, const vpdsi_rn
     ctx->stats->darts += j;
 }
 
-static vpds_status darts_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
+/* A chunk's darts, their radii and, in weighted mode, which are kept (Eq. 12 by rejection:
+ * with probability (r_min / r(y))^d, so accepted darts have density proportional to 1 / r^d
+ * over the free region). On an error no draw is spent: a retry throws the same darts. */
+static vpds_status prepare_darts(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, int weighted)
 {
-    const vpdsi_problem *pb = ctx->pb;
     vpdsi_store *st = ctx->st;
-    int d = pb->dim;
-    int varying = st->sizing.kind != VPDSI_SIZING_CONSTANT;
-    int weighted = pb->weighted && varying;
-    double scale = m->run.t * pb->inhibition;
+    int d = ctx->pb->dim, k;
     vpdsi_rng start = *ctx->rng;
-    vpdsi_kd_samples view;
     vpds_status e;
     size_t j;
     if ((e = reserve_buffers(m, ctx, n)) != VPDS_OK) return e;
@@ -244,85 +242,100 @@ static vpds_status darts_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
         return VPDS_ERR_OUT_OF_MEMORY;
     }
     draw_darts(m, ctx, ctx->rng, n, m->buf_x, weighted ? m->buf_u : NULL);
-    if (varying) {
-        e = vpdsi_store_radii(st, m->buf_x, n, m->buf_r);
-        if (e != VPDS_OK) {
-            *ctx->rng = start; /* no draw spent: a retry throws the same darts */
+    if (st->sizing.kind == VPDSI_SIZING_CONSTANT) {
+        for (j = 0; j < n; j++) m->buf_r[j] = st->sizing.radius;
+    } else if ((e = vpdsi_store_radii(st, m->buf_x, n, m->buf_r)) != VPDS_OK) {
+        *ctx->rng = start;
+        return e;
+    }
+    for (j = 0; weighted && j < n; j++) {
+        double ratio = st->sizing.rmin / m->buf_r[j], keep = 1;
+        if (m->buf_r[j] < st->sizing.rmin) {
+            char py[256];
+            vpdsi_format_point(py, sizeof py, m->buf_x + j * (size_t)d, d);
+            vpdsi_store_error(st, "sizing returned r = %.17g at x = (%s), below radius_min = %.17g",
+                              m->buf_r[j], py, st->sizing.rmin);
+            *ctx->rng = start;
+            return VPDS_ERR_SIZING;
+        }
+        for (k = 0; k < d; k++) keep *= ratio;
+        m->buf_u[j] = m->buf_u[j] < keep ? 1.0 : 0.0;
+    }
+    return VPDS_OK;
+}
+
+/* The dart y of radius ry met sample i whose radius breaks the sizing's L. */
+static vpds_status lipschitz_broken(vpdsi_store *st, const double *y, double ry, int32_t i)
+{
+    char py[256], px[256];
+    const double *x = st->x + (size_t)i * (size_t)st->dim;
+    double dist = 0;
+    int k;
+    for (k = 0; k < st->dim; k++) dist += (y[k] - x[k]) * (y[k] - x[k]);
+    dist = sqrt(dist);
+    vpdsi_format_point(py, sizeof py, y, st->dim);
+    vpdsi_format_point(px, sizeof px, x, st->dim);
+    vpdsi_store_error(st, "sizing breaks lipschitz = %g: r = %.17g at (%s) and r = %.17g at (%s), "
+                      "distance %.17g, slope %.17g", st->sizing.lipschitz, ry, py, st->r[i], px,
+                      dist, fabs(ry - st->r[i]) / dist);
+    return VPDS_ERR_LIPSCHITZ;
+}
+
+/* Whether the dart y (radius ry) becomes a sample (Eq. 4): it conflicts with no sample, lies
+ * in the domain and, with two radii, covers a point not yet covered (Section 3.1, first
+ * option). */
+static vpds_status judge_dart(vpdsi_mps *m, const vpdsi_ctx *ctx, const double *y, double ry,
+                              int *accept)
+{
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_store *st = ctx->st;
+    int varying = st->sizing.kind != VPDSI_SIZING_CONSTANT;
+    double scale = m->run.t * pb->inhibition;
+    int32_t witness = -1, hit;
+    vpds_status e;
+    *accept = 0;
+    if (st->grid_mode) {
+        hit = vpdsi_bgrid_conflict(&st->grid, st->x, y, scale * st->sizing.radius);
+    } else {
+        vpdsi_kd_samples view = vpdsi_store_view(st);
+        hit = vpdsi_kd_conflict(&st->tree, &view, y, ry, (int)pb->rule, scale,
+                                varying ? st->sizing.lipschitz : -1.0, &witness);
+    }
+    if (hit == -2) return lipschitz_broken(st, y, ry, witness);
+    if (hit != -1) return VPDS_OK; /* conflicts with sample hit */
+    if (ctx->dom->fn) {
+        double phi;
+        if ((e = vpdsi_domain_at(ctx->dom, st, y, &phi)) != VPDS_OK) return e;
+        if (phi > 0) return VPDS_OK; /* outside the domain: rejected, as uniform over it wants */
+    }
+    if (pb->two_radii) {
+        /* no cell that may hold an uncovered point within reach: nothing new to cover */
+        if (vpdsi_uncovered_nearest(&m->unc, y) > coverage_reach(m, ctx, ry) + m->unc.half)
+            return VPDS_OK;
+        return vpdsi_uncovered_in(&m->unc, ctx, m->run.t, y, y, ry, accept);
+    }
+    *accept = 1;
+    return VPDS_OK;
+}
+
+static vpds_status darts_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
+{
+    vpdsi_store *st = ctx->st;
+    int weighted = ctx->pb->weighted && st->sizing.kind != VPDSI_SIZING_CONSTANT;
+    vpdsi_rng start = *ctx->rng;
+    vpds_status e;
+    size_t j;
+    if ((e = prepare_darts(m, ctx, n, weighted)) != VPDS_OK) return e;
+    for (j = 0; j < n; j++) {
+        const double *y = m->buf_x + j * (size_t)ctx->pb->dim;
+        int accept;
+        if (weighted && m->buf_u[j] == 0.0) continue;
+        if ((e = judge_dart(m, ctx, y, m->buf_r[j], &accept)) != VPDS_OK) {
+            /* keep the darts before this one, as a pause would */
+            keep_darts_before(m, ctx, &start, j, weighted);
             return e;
         }
-    } else {
-        for (j = 0; j < n; j++) m->buf_r[j] = st->sizing.radius;
-    }
-    if (weighted) {
-        /* Eq. 12 by rejection: keep a dart with probability (r_min / r(y))^d, so accepted darts
-         * have density proportional to 1 / r^d over the free region */
-        for (j = 0; j < n; j++) {
-            if (m->buf_r[j] < st->sizing.rmin) {
-                char py[256];
-                vpdsi_format_point(py, sizeof py, m->buf_x + j * (size_t)d, d);
-                vpdsi_store_error(st, "sizing returned r = %.17g at x = (%s), below radius_min = %.17g",
-                                m->buf_r[j], py, st->sizing.rmin);
-                *ctx->rng = start;
-                return VPDS_ERR_SIZING;
-            }
-            {
-                double ratio = st->sizing.rmin / m->buf_r[j], keep = 1;
-                int k;
-                for (k = 0; k < d; k++) keep *= ratio;
-                m->buf_u[j] = m->buf_u[j] < keep ? 1.0 : 0.0;
-            }
-        }
-    }
-    for (j = 0; j < n; j++) {
-        const double *y = m->buf_x + j * (size_t)d;
-        int32_t witness = -1, hit;
-        if (weighted && m->buf_u[j] == 0.0) continue;
-        if (st->grid_mode) {
-            hit = vpdsi_bgrid_conflict(&st->grid, st->x, y, scale * st->sizing.radius);
-        } else {
-            view = vpdsi_store_view(st);
-            hit = vpdsi_kd_conflict(&st->tree, &view, y, m->buf_r[j], (int)pb->rule, scale,
-                                    varying ? st->sizing.lipschitz : -1.0, &witness);
-        }
-        if (hit == -2) {
-            char py[256], px[256];
-            const double *x = st->x + (size_t)witness * (size_t)d;
-            double dist = 0;
-            int k;
-            for (k = 0; k < d; k++) dist += (y[k] - x[k]) * (y[k] - x[k]);
-            dist = sqrt(dist);
-            vpdsi_format_point(py, sizeof py, y, d);
-            vpdsi_format_point(px, sizeof px, x, d);
-            vpdsi_store_error(st, "sizing breaks lipschitz = %g: r = %.17g at (%s) and r = %.17g at"
-                            " (%s), distance %.17g, slope %.17g", st->sizing.lipschitz,
-                            m->buf_r[j], py, st->r[witness], px, dist,
-                            fabs(m->buf_r[j] - st->r[witness]) / dist);
-            keep_darts_before(m, ctx, &start, j, weighted);
-            return VPDS_ERR_LIPSCHITZ;
-        }
-        if (hit == -1 && ctx->dom->fn) {
-            double phi;
-            if ((e = vpdsi_domain_at(ctx->dom, st, y, &phi)) != VPDS_OK) {
-                keep_darts_before(m, ctx, &start, j, weighted);
-                return e;
-            }
-            if (phi > 0) hit = -4; /* outside the domain: rejected, as uniform over it wants */
-        }
-        if (hit == -1 && pb->two_radii) {
-            /* Section 3.1, first option: the dart must cover a point not yet covered */
-            int found = 0;
-            e = VPDS_OK;
-            if (vpdsi_uncovered_nearest(&m->unc, y) > coverage_reach(m, ctx, m->buf_r[j]) + m->unc.half)
-                found = 0; /* no cell that may hold an uncovered point is within reach */
-            else
-                e = vpdsi_uncovered_in(&m->unc, ctx, m->run.t, y, y, m->buf_r[j], &found);
-            if (e != VPDS_OK) {
-                keep_darts_before(m, ctx, &start, j, weighted);
-                return e;
-            }
-            if (!found) hit = -3;
-        }
-        if (hit == -1) {
+        if (accept) {
             vpdsi_store_append(st, y, m->buf_r[j], m->run.t, 0);
             ctx->stats->accepted++;
         }
@@ -415,109 +428,155 @@ static vpds_status drop_outside_children(vpdsi_mps *m, const vpdsi_ctx *ctx, uns
     return VPDS_OK;
 }
 
-/* Sweep n cells from run->pos: drop covered ones, keep the others (split: their uncovered
- * children) in run->next. run->pos advances cell by cell, so an error mid-chunk loses nothing. */
-static vpds_status sweep_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, int split)
+/* Coordinates of child b of cell c (bit k of b: the upper half on axis k); without a split
+ * the "child" is the cell itself. */
+static void child_coords(int d, const uint64_t *c, unsigned b, int split, uint64_t *cc)
+{
+    int k;
+    for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
+}
+
+static int bit_set(const uint64_t *bits, unsigned b) { return (int)(bits[b >> 6] >> (b & 63u) & 1u); }
+
+/* r at the centres of the n cells from run->pos: it bounds r over each cell through L. */
+static vpds_status centre_radii(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, unsigned level)
+{
+    int d = ctx->pb->dim, k;
+    uint64_t c[VPDS_MAX_DIM];
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
+    vpds_status e;
+    size_t j;
+    if ((e = reserve_buffers(m, ctx, n)) != VPDS_OK) return e;
+    for (j = 0; j < n; j++) {
+        cell_coords(m, ctx, m->run.pos + j, c);
+        vpdsi_lattice_box(&m->run.geom, level, c, lo, hi);
+        for (k = 0; k < d; k++) m->buf_x[j * (size_t)d + (size_t)k] = 0.5 * (lo[k] + hi[k]);
+    }
+    return vpdsi_store_radii(ctx->st, m->buf_x, n, m->buf_r);
+}
+
+/* The samples that may cover part of cell c ([lo, hi], r <= r_hi over it) into m->cand. */
+static vpds_status gather_near(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t *c,
+                               unsigned level, const double *lo, const double *hi, double r_hi,
+                               int split)
+{
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_store *st = ctx->st;
+    double scale = m->run.t * (pb->two_radii ? pb->coverage : pb->inhibition);
+    vpdsi_kd_samples view = vpdsi_store_view(st);
+    m->n_cand = 0;
+    if (st->grid_mode) {
+        uint64_t base[VPDS_MAX_DIM];
+        int k;
+        for (k = 0; k < pb->dim; k++) base[k] = c[k] >> level; /* the base cell holding this one */
+        m->n_cand = vpdsi_bgrid_near(&st->grid, vpdsi_bgrid_index(&st->grid, base), m->cand);
+    } else if (vpdsi_kd_gather(&st->tree, &view, lo, hi, r_hi, (int)pb->rule, scale, split,
+                               ctx->mem, &m->cand, &m->n_cand, &m->cap_cand)) {
+        vpdsi_store_error(st, "out of memory gathering the samples near a cell");
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    return VPDS_OK;
+}
+
+/* Two radii: which kept children may hold an uncovered point: not inside one coverage disk
+ * (the gather, at the larger coverage reach, found every candidate), and not shown covered by
+ * a search inside them; decided before anything is kept. */
+static vpds_status flag_uncovered(vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned level,
+                                  const uint64_t *c, int split, const double *lo,
+                                  const double *hi, double r_lo, const uint64_t *covered,
+                                  uint8_t *flag)
+{
+    int d = ctx->pb->dim;
+    unsigned children = split ? 1u << d : 1u, b;
+    uint64_t cov_c[4] = {0, 0, 0, 0}, cc[VPDS_MAX_DIM];
+    double scale_c = m->run.t * ctx->pb->coverage;
+    vpds_status e;
+    if (box_covered(m, ctx, lo, hi, r_lo, scale_c))
+        cov_c[0] = cov_c[1] = cov_c[2] = cov_c[3] = ~UINT64_C(0);
+    else if (split)
+        children_covered(m, ctx, level, c, r_lo, scale_c, cov_c);
+    for (b = 0; b < children; b++) {
+        double clo[VPDS_MAX_DIM], chi[VPDS_MAX_DIM];
+        int found = 0;
+        flag[b] = 0;
+        if (bit_set(covered, b) || bit_set(cov_c, b)) continue;
+        child_coords(d, c, b, split, cc);
+        vpdsi_lattice_box(&m->run.geom, split ? level + 1 : level, cc, clo, chi);
+        if ((e = vpdsi_uncovered_in(&m->unc, ctx, m->run.t, clo, chi, 0.0, &found)) != VPDS_OK)
+            return e;
+        flag[b] = (uint8_t)found;
+    }
+    return VPDS_OK;
+}
+
+/* One cell of the sweep (coordinates c, r at its centre rc): its uncovered children (or the
+ * cell itself) into run->next, unless the cell lies outside the domain or inside one disk. */
+static vpds_status sweep_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t *c, double rc,
+                              int need_r, int split)
 {
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_store *st = ctx->st;
     vpdsi_run *run = &m->run;
     int d = pb->dim, k;
     unsigned level = cur_level(m), children = split ? 1u << d : 1u, b;
-    int varying = st->sizing.kind != VPDSI_SIZING_CONSTANT;
-    /* r over the cell: for a rule that reads r(y), and for the reach of two radii' V */
-    int need_r = varying && (vpdsi_rule_uses_y(pb->rule) || pb->two_radii);
     /* a cell is dropped inside one inhibition disk (with one radius: one coverage disk) */
     double scale = run->t * pb->inhibition, L = st->sizing.lipschitz;
-    uint64_t c[VPDS_MAX_DIM], cc[VPDS_MAX_DIM];
     double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], centre[VPDS_MAX_DIM], phi = -INFINITY;
+    double h = sqrt(vpdsi_lattice_box(&run->geom, level, c, lo, hi));
+    double r_lo = need_r ? rc - L * h / 2 : st->sizing.radius;
+    double r_hi = need_r ? rc + L * h / 2 : st->sizing.radius;
+    uint64_t covered[4] = {0, 0, 0, 0}, cc[VPDS_MAX_DIM];
+    uint8_t flag[1u << VPDS_MAX_DIM]; /* two radii: the child may hold an uncovered point */
+    vpds_status e;
+    if (ctx->dom->fn) {
+        for (k = 0; k < d; k++) centre[k] = 0.5 * (lo[k] + hi[k]);
+        if ((e = vpdsi_domain_at(ctx->dom, st, centre, &phi)) != VPDS_OK) return e;
+        if (phi > 0.5 * h) return VPDS_OK; /* outside the domain, whole */
+    }
+    if ((e = gather_near(m, ctx, c, level, lo, hi, r_hi, split)) != VPDS_OK) return e;
+    if (box_covered(m, ctx, lo, hi, r_lo, scale)) return VPDS_OK;
+    if (split) children_covered(m, ctx, level, c, r_lo, scale, covered);
+    if (ctx->dom->fn && phi > -0.5 * h &&
+        (e = drop_outside_children(m, ctx, level, c, split, centre, phi, covered)) != VPDS_OK)
+        return e;
+    if (pb->two_radii &&
+        (e = flag_uncovered(m, ctx, level, c, split, lo, hi, r_lo, covered, flag)) != VPDS_OK)
+        return e;
+    for (b = 0; b < children; b++) {
+        if (bit_set(covered, b)) continue;
+        if (pb->two_radii) m->unc.flag[run->next.count] = flag[b];
+        child_coords(d, c, b, split, cc);
+        vpdsi_cells_push(&run->next, d, cc);
+    }
+    return VPDS_OK;
+}
+
+/* Sweep n cells from run->pos: drop covered ones, keep the others (split: their uncovered
+ * children) in run->next. run->pos advances cell by cell, so an error mid-chunk loses nothing. */
+static vpds_status sweep_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, int split)
+{
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_run *run = &m->run;
+    unsigned children = split ? 1u << pb->dim : 1u;
+    int varying = ctx->st->sizing.kind != VPDSI_SIZING_CONSTANT;
+    /* r over the cell: for a rule that reads r(y), and for the reach of two radii' V */
+    int need_r = varying && (vpdsi_rule_uses_y(pb->rule) || pb->two_radii);
+    uint64_t c[VPDS_MAX_DIM];
     size_t j, need;
     vpds_status e;
     if (vpdsi_mul_size(n, children, &need) ||
         vpdsi_cells_reserve(&run->next, ctx->mem, run->next.count + need) ||
         (pb->two_radii && vpdsi_mem_reserve(ctx->mem, (void **)&m->unc.flag, &m->unc.cap_flag,
-                                           run->next.count + need, 1))) {
-        vpdsi_store_error(st, "out of memory for the active cells of level %u", run->next.level);
+                                            run->next.count + need, 1))) {
+        vpdsi_store_error(ctx->st, "out of memory for the active cells of level %u", run->next.level);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
-    if (need_r) {
-        /* r at the cell centres bounds r over each cell through L */
-        if ((e = reserve_buffers(m, ctx, n)) != VPDS_OK) return e;
-        for (j = 0; j < n; j++) {
-            cell_coords(m, ctx, run->pos + j, c);
-            vpdsi_lattice_box(&m->run.geom, level, c, lo, hi);
-            for (k = 0; k < d; k++) m->buf_x[j * (size_t)d + (size_t)k] = 0.5 * (lo[k] + hi[k]);
-        }
-        e = vpdsi_store_radii(st, m->buf_x, n, m->buf_r);
-        if (e != VPDS_OK) return e;
-    }
+    if (need_r && (e = centre_radii(m, ctx, n, cur_level(m))) != VPDS_OK) return e;
     for (j = 0; j < n; j++) {
-        double h = sqrt(vpdsi_lattice_box(&m->run.geom, level, (cell_coords(m, ctx, run->pos, c), c), lo, hi));
-        double r_lo = st->sizing.radius, r_hi = st->sizing.radius;
-        uint64_t covered[4] = {0, 0, 0, 0};
-        uint8_t flag[1u << VPDS_MAX_DIM]; /* two radii: the child may hold an uncovered point */
-        vpdsi_kd_samples view = vpdsi_store_view(st);
-        if (need_r) {
-            r_lo = m->buf_r[j] - L * h / 2;
-            r_hi = m->buf_r[j] + L * h / 2;
-        }
-        if (ctx->dom->fn) {
-            for (k = 0; k < d; k++) centre[k] = 0.5 * (lo[k] + hi[k]);
-            if ((e = vpdsi_domain_at(ctx->dom, st, centre, &phi)) != VPDS_OK) return e;
-            if (phi > 0.5 * h) { /* outside the domain, whole */
-                run->pos++;
-                continue;
-            }
-        }
-        m->n_cand = 0;
-        if (st->grid_mode) {
-            uint64_t base[VPDS_MAX_DIM];
-            for (k = 0; k < d; k++) base[k] = c[k] >> level; /* the base cell holding this one */
-            m->n_cand = vpdsi_bgrid_near(&st->grid, vpdsi_bgrid_index(&st->grid, base), m->cand);
-        } else if (vpdsi_kd_gather(&st->tree, &view, lo, hi, r_hi, (int)pb->rule,
-                                   pb->two_radii ? run->t * pb->coverage : scale, split,
-                                   ctx->mem, &m->cand, &m->n_cand, &m->cap_cand)) {
-            vpdsi_store_error(st, "out of memory gathering the samples near a cell");
-            return VPDS_ERR_OUT_OF_MEMORY;
-        }
-        if (box_covered(m, ctx, lo, hi, r_lo, scale)) {
-            run->pos++;
-            continue;
-        }
-        if (split) children_covered(m, ctx, level, c, r_lo, scale, covered);
-        if (ctx->dom->fn && phi > -0.5 * h &&
-            (e = drop_outside_children(m, ctx, level, c, split, centre, phi, covered)) != VPDS_OK)
+        cell_coords(m, ctx, run->pos, c);
+        if ((e = sweep_cell(m, ctx, c, need_r ? m->buf_r[j] : 0.0, need_r, split)) != VPDS_OK)
             return e;
-        if (pb->two_radii) {
-            /* which kept children may hold an uncovered point: not inside one coverage disk
-             * (the gather above, at the larger coverage reach, found every candidate), and
-             * not shown covered by a search inside them; decided before anything is kept */
-            uint64_t cov_c[4] = {0, 0, 0, 0};
-            double scale_c = run->t * pb->coverage;
-            if (box_covered(m, ctx, lo, hi, r_lo, scale_c)) {
-                cov_c[0] = cov_c[1] = cov_c[2] = cov_c[3] = ~UINT64_C(0);
-            } else if (split) {
-                children_covered(m, ctx, level, c, r_lo, scale_c, cov_c);
-            }
-            for (b = 0; b < children; b++) {
-                double clo[VPDS_MAX_DIM], chi[VPDS_MAX_DIM];
-                int found = 0;
-                flag[b] = 0;
-                if ((covered[b >> 6] >> (b & 63u) & 1u) || (cov_c[b >> 6] >> (b & 63u) & 1u))
-                    continue;
-                for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
-                vpdsi_lattice_box(&m->run.geom, split ? level + 1 : level, cc, clo, chi);
-                if ((e = vpdsi_uncovered_in(&m->unc, ctx, m->run.t, clo, chi, 0.0, &found)) != VPDS_OK) return e;
-                flag[b] = (uint8_t)found;
-            }
-        }
         run->pos++;
-        for (b = 0; b < children; b++) {
-            if (covered[b >> 6] >> (b & 63u) & 1u) continue;
-            if (pb->two_radii) m->unc.flag[run->next.count] = flag[b];
-            for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
-            vpdsi_cells_push(&run->next, d, cc);
-        }
     }
     return VPDS_OK;
 }
@@ -600,9 +659,77 @@ static void begin_sweep(vpdsi_mps *m, const vpdsi_ctx *ctx, int split)
     m->run.pos = 0;
 }
 
+/* One chunk of the sweep (or the filter) of at most limit cells; *done: work units spent. */
+static vpds_status sweep_step(vpdsi_mps *m, const vpdsi_ctx *ctx, uint64_t limit, uint64_t *done)
+{
+    vpdsi_run *run = &m->run;
+    int split = run->phase == VPDSI_SWEEP && cur_level(m) < run->max_level;
+    uint64_t total = cur_count(m), before = run->pos;
+    vpds_status e;
+    if (total - run->pos < limit) limit = total - run->pos;
+    e = sweep_chunk(m, ctx, (size_t)limit, split);
+    *done = run->pos - before;
+    if (e != VPDS_OK || run->pos != total) return e;
+    if (ctx->pb->two_radii) {
+        run->vsplit = split | (run->phase == VPDSI_FILTER ? 2 : 0);
+        run->vpos = run->wpos = 0;
+        m->unc.ready = 0;
+        run->phase = VPDSI_VFILTER;
+    } else {
+        finish_sweep(m, ctx, split);
+    }
+    return VPDS_OK;
+}
+
+/* One chunk of the two radii' filter of the new cells. */
+static vpds_status vfilter_step(vpdsi_mps *m, const vpdsi_ctx *ctx, uint64_t limit, uint64_t *done)
+{
+    vpdsi_run *run = &m->run;
+    uint64_t total = run->next.count, before = run->vpos;
+    vpds_status e;
+    if (total - run->vpos < limit) limit = total - run->vpos;
+    e = vfilter_chunk(m, ctx, (size_t)limit);
+    *done = run->vpos - before;
+    if (e != VPDS_OK || run->vpos != total) return e;
+    run->next.count = (size_t)run->wpos;
+    /* finish_sweep tells a precision stop by the phase: restore the sweep's */
+    run->phase = run->vsplit & 2 ? VPDSI_FILTER : VPDSI_SWEEP;
+    finish_sweep(m, ctx, run->vsplit & 1);
+    return VPDS_OK;
+}
+
+/* One chunk of darts (or the start of the level's sweep once they are thrown). */
+static vpds_status darts_step(vpdsi_mps *m, const vpdsi_ctx *ctx, uint64_t limit, uint64_t *done)
+{
+    vpdsi_run *run = &m->run;
+    uint64_t before = run->darts_left;
+    vpds_status e;
+    *done = 0;
+    if (run->darts_left == 0) {
+        run->phase = VPDSI_SWEEP;
+        begin_sweep(m, ctx, cur_level(m) < run->max_level);
+        return VPDS_OK;
+    }
+    if (run->darts_left < limit) limit = run->darts_left;
+    e = darts_chunk(m, ctx, (size_t)limit);
+    *done = before - run->darts_left;
+    return e;
+}
+
+/* Whether the progress callback asks to stop. */
+static int progress_stops(const vpdsi_mps *m, const vpdsi_ctx *ctx, const vpdsi_work *w)
+{
+    vpds_progress p;
+    p.darts = ctx->stats->darts;
+    p.samples = ctx->st->n;
+    p.active_cells = m->run.phase == VPDSI_DONE ? 0 : cur_count(m);
+    p.level = cur_level(m);
+    p.t = m->run.t;
+    return w->progress(&p, w->user) != 0;
+}
+
 vpds_status vpdsi_mps_run(vpdsi_mps *m, const vpdsi_ctx *ctx, const vpdsi_work *w)
 {
-    vpdsi_store *st = ctx->st;
     vpdsi_run *run = &m->run;
     uint64_t work = 0;
     vpds_status e = VPDS_OK;
@@ -612,12 +739,13 @@ vpds_status vpdsi_mps_run(vpdsi_mps *m, const vpdsi_ctx *ctx, const vpdsi_work *
         if (run->phase == VPDSI_FILTER) begin_sweep(m, ctx, 0);
     }
     for (;;) {
-        uint64_t limit = CHUNK, before;
-        if (run->phase == VPDSI_DONE && st->n == 0 && ctx->dom->fn) {
+        uint64_t limit = CHUNK, done = 0;
+        int begins_sweep = run->phase == VPDSI_DARTS && run->darts_left == 0;
+        if (run->phase == VPDSI_DONE && ctx->st->n == 0 && ctx->dom->fn) {
             /* nothing to sample: say so, and leave the sampler as it was */
             vpdsi_mps_reset(m, run->t);
-            vpdsi_store_error(st, "domain: no point of the box with sdf <= 0 was found (the domain is"
-                            " empty, or too thin for darts to land in)");
+            vpdsi_store_error(ctx->st, "domain: no point of the box with sdf <= 0 was found (the "
+                              "domain is empty, or too thin for darts to land in)");
             return VPDS_ERR_DOMAIN;
         }
         if (run->phase == VPDSI_DONE) return VPDS_OK;
@@ -625,65 +753,15 @@ vpds_status vpdsi_mps_run(vpdsi_mps *m, const vpdsi_ctx *ctx, const vpdsi_work *
         if (w->budget && w->budget - work < limit) limit = w->budget - work;
         switch (run->phase) {
         case VPDSI_FILTER:
-        case VPDSI_SWEEP: {
-            int split = run->phase == VPDSI_SWEEP && cur_level(m) < run->max_level;
-            uint64_t total = cur_count(m);
-            before = run->pos;
-            if (total - run->pos < limit) limit = total - run->pos;
-            e = sweep_chunk(m, ctx, (size_t)limit, split);
-            work += run->pos - before;
-            if (e != VPDS_OK) return e;
-            if (run->pos == total) {
-                if (ctx->pb->two_radii) {
-                    run->vsplit = split | (run->phase == VPDSI_FILTER ? 2 : 0);
-                    run->vpos = run->wpos = 0;
-                    m->unc.ready = 0;
-                    run->phase = VPDSI_VFILTER;
-                } else {
-                    finish_sweep(m, ctx, split);
-                }
-            }
-            break;
+        case VPDSI_SWEEP: e = sweep_step(m, ctx, limit, &done); break;
+        case VPDSI_VFILTER: e = vfilter_step(m, ctx, limit, &done); break;
+        case VPDSI_DARTS: e = darts_step(m, ctx, limit, &done); break;
+        default: return VPDS_ERR_STATE;
         }
-        case VPDSI_VFILTER: {
-            uint64_t total = run->next.count;
-            before = run->vpos;
-            if (total - run->vpos < limit) limit = total - run->vpos;
-            e = vfilter_chunk(m, ctx, (size_t)limit);
-            work += run->vpos - before;
-            if (e != VPDS_OK) return e;
-            if (run->vpos == total) {
-                run->next.count = (size_t)run->wpos;
-                /* finish_sweep tells a precision stop by the phase: restore the sweep's */
-                run->phase = run->vsplit & 2 ? VPDSI_FILTER : VPDSI_SWEEP;
-                finish_sweep(m, ctx, run->vsplit & 1);
-            }
-            break;
-        }
-        case VPDSI_DARTS:
-            if (run->darts_left == 0) {
-                run->phase = VPDSI_SWEEP;
-                begin_sweep(m, ctx, cur_level(m) < run->max_level);
-                continue;
-            }
-            if (run->darts_left < limit) limit = run->darts_left;
-            before = run->darts_left;
-            e = darts_chunk(m, ctx, (size_t)limit);
-            work += before - run->darts_left;
-            if (e != VPDS_OK) return e;
-            break;
-        default:
-            return VPDS_ERR_STATE;
-        }
-        if (w->progress) {
-            vpds_progress p;
-            p.darts = ctx->stats->darts;
-            p.samples = st->n;
-            p.active_cells = run->phase == VPDSI_DONE ? 0 : cur_count(m);
-            p.level = cur_level(m);
-            p.t = run->t;
-            if (w->progress(&p, w->user) != 0)
-                return run->phase == VPDSI_DONE ? VPDS_OK : VPDS_PAUSED;
-        }
+        work += done;
+        if (e != VPDS_OK) return e;
+        if (begins_sweep) continue; /* only the sweep began: no progress to report */
+        if (w->progress && progress_stops(m, ctx, w))
+            return run->phase == VPDSI_DONE ? VPDS_OK : VPDS_PAUSED;
     }
 }

@@ -214,67 +214,137 @@ static vpds_status eval_boxes(vpdsi_stream *sm, const vpdsi_ctx *ctx, const doub
     return VPDS_OK;
 }
 
-/* Best-first search for the maximum of g over one region, to the tolerance: *bound is an upper
- * bound of g over the region and g(y) = *gy >= *bound / (1 + tolerance). With a domain the
- * tolerance is VPDS_STREAM_DOMAIN_TOLERANCE: on a curved boundary g is often maximal where it
- * varies quadratically along the boundary, so a tolerance eps costs about 1/eps boxes there. */
-static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centre, const double *half,
-                                 double *bound, double *y, double *gy)
+/* The state of one region's search: the best point so far and the bounds left behind. */
+typedef struct {
+    double best, extra;  /* g at y; the largest bound of boxes no longer searched */
+    double *y;
+    double tol;
+} region_search;
+
+/* Split the open box (centre cb, half sides hb, already halved) into its 2^d children: each
+ * may improve the best point; those that may still beat it by more than the tolerance stay
+ * open, the others leave only their bound. */
+static vpds_status split_box(vpdsi_stream *sm, const vpdsi_ctx *ctx, region_search *q,
+                             const double *cb, const double *hb)
 {
-    const vpdsi_problem *pb = ctx->pb;
-    int d = pb->dim, k;
+    int d = sm->geom.dim, k;
     size_t w = 1 + 2 * (size_t)d, children = (size_t)1 << d, j;
-    double best = -1, extra = -1; /* extra: bounds of boxes no longer searched */
-    double tol = ctx->dom->fn ? VPDS_STREAM_DOMAIN_TOLERANCE : VPDS_STREAM_TOLERANCE;
-    long splits;
-    double g1, ub1, cs[(1u << VPDS_MAX_DIM) * VPDS_MAX_DIM], gs[1u << VPDS_MAX_DIM],
-        ubs[1u << VPDS_MAX_DIM], mag = 0;
+    double cs[(1u << VPDS_MAX_DIM) * VPDS_MAX_DIM], gs[1u << VPDS_MAX_DIM], ubs[1u << VPDS_MAX_DIM];
     vpds_status e;
-    for (k = 0; k < d; k++) {
+    for (j = 0; j < children; j++)
+        for (k = 0; k < d; k++)
+            cs[j * (size_t)d + (size_t)k] = cb[k] + ((j >> k) & 1u ? hb[k] : -hb[k]);
+    if ((e = eval_boxes(sm, ctx, cs, children, hb, gs, ubs)) != VPDS_OK) return e;
+    if (vpdsi_mem_reserve(ctx->mem, (void **)&sm->boxes, &sm->cap_boxes,
+                          (sm->n_boxes + children) * w, sizeof(double))) {
+        vpdsi_store_error(ctx->st, "out of memory in the stream's search");
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    for (j = 0; j < children; j++) {
+        if (gs[j] > q->best) {
+            q->best = gs[j];
+            memcpy(q->y, cs + j * (size_t)d, (size_t)d * sizeof(double));
+        }
+    }
+    for (j = 0; j < children; j++) {
+        double *r;
+        if (ubs[j] < 0) continue; /* outside the domain */
+        if (ubs[j] <= q->best * (1 + q->tol)) {
+            /* cannot beat the best by more than the tolerance: keep only its bound */
+            if (ubs[j] > q->extra) q->extra = ubs[j];
+            continue;
+        }
+        r = sm->boxes + sm->n_boxes++ * w;
+        r[0] = ubs[j];
+        memcpy(r + 1, cs + j * (size_t)d, (size_t)d * sizeof(double));
+        memcpy(r + 1 + d, hb, (size_t)d * sizeof(double));
+    }
+    return VPDS_OK;
+}
+
+/* The open box of the largest bound (the open boxes form a small list: a linear scan). */
+static size_t best_box(const vpdsi_stream *sm, double *top)
+{
+    size_t w = 1 + 2 * (size_t)sm->geom.dim, j, at = 0;
+    *top = -1;
+    for (j = 0; j < sm->n_boxes; j++)
+        if (sm->boxes[j * w] > *top) {
+            *top = sm->boxes[j * w];
+            at = j;
+        }
+    return at;
+}
+
+/* Largest coordinate magnitude or extent of the box: the scale of the doubles' precision. */
+static double box_magnitude(const vpdsi_problem *pb)
+{
+    double mag = 0;
+    int k;
+    for (k = 0; k < pb->dim; k++) {
         double m = fabs(pb->lo[k]) > fabs(pb->hi[k]) ? fabs(pb->lo[k]) : fabs(pb->hi[k]);
         if (pb->hi[k] - pb->lo[k] > m) m = pb->hi[k] - pb->lo[k];
         if (m > mag) mag = m;
     }
+    return mag;
+}
+
+static vpds_status search_diverged(const vpdsi_ctx *ctx, const double *centre)
+{
+    /* never seen without a domain; a domain whose boundary the 1-Lipschitz bound cannot
+     * resolve (a sliver the box centres miss) would otherwise keep the search going */
+    char pc[256];
+    vpdsi_format_point(pc, sizeof pc, centre, ctx->pb->dim);
+    vpdsi_store_error(ctx->st, "vpds_next: the search for the farthest point near (%s) did not "
+                      "converge in %d box splits (a domain too thin for its signed distance to "
+                      "resolve?)", pc, STREAM_SEARCH_BUDGET);
+    return VPDS_ERR_DOMAIN;
+}
+
+/* Best-first search for the maximum of g over one region, to the tolerance: *bound is an upper
+ * bound of g over the region and g(y) = *gy >= *bound / (1 + tolerance). With a domain the
+ * tolerance is VPDS_STREAM_DOMAIN_TOLERANCE: on a curved boundary g is often maximal where it
+ * varies quadratically along the boundary, so a tolerance eps costs about 1/eps boxes there. */
+static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centre,
+                                 const double *half, double *bound, double *y, double *gy)
+{
+    int d = ctx->pb->dim, k;
+    size_t w = 1 + 2 * (size_t)d;
+    double g1, ub1, mag = box_magnitude(ctx->pb);
+    region_search q;
+    long splits;
+    vpds_status e;
+    q.tol = ctx->dom->fn ? VPDS_STREAM_DOMAIN_TOLERANCE : VPDS_STREAM_TOLERANCE;
+    q.extra = -1;
+    q.y = y;
     if ((e = eval_boxes(sm, ctx, centre, 1, half, &g1, &ub1)) != VPDS_OK) return e;
-    best = g1;
+    q.best = g1;
     memcpy(y, centre, (size_t)d * sizeof(double));
     sm->n_boxes = 0;
-    if (vpdsi_mem_reserve(ctx->mem, (void **)&sm->boxes, &sm->cap_boxes, w, sizeof(double))) goto oom;
+    if (vpdsi_mem_reserve(ctx->mem, (void **)&sm->boxes, &sm->cap_boxes, w, sizeof(double))) {
+        vpdsi_store_error(ctx->st, "out of memory in the stream's search");
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
     sm->boxes[0] = ub1;
     memcpy(sm->boxes + 1, centre, (size_t)d * sizeof(double));
     memcpy(sm->boxes + 1 + d, half, (size_t)d * sizeof(double));
     sm->n_boxes = 1;
     for (splits = 0;; splits++) {
-        double top = -1, hb[VPDS_MAX_DIM], cb[VPDS_MAX_DIM], hmax = 0, U;
-        size_t at = 0;
-        if (splits == STREAM_SEARCH_BUDGET) {
-            /* never seen without a domain; a domain whose boundary the 1-Lipschitz bound cannot
-             * resolve (a sliver the box centres miss) would otherwise keep the search going */
-            char pc[256];
-            vpdsi_format_point(pc, sizeof pc, centre, d);
-            vpdsi_store_error(ctx->st, "vpds_next: the search for the farthest point near (%s) did not "
-                            "converge in %d box splits (a domain too thin for its signed distance"
-                            " to resolve?)", pc, STREAM_SEARCH_BUDGET);
-            return VPDS_ERR_DOMAIN;
-        }
-        /* the open boxes form a small list; a linear scan finds the best (they are few) */
-        for (j = 0; j < sm->n_boxes; j++)
-            if (sm->boxes[j * w] > top) {
-                top = sm->boxes[j * w];
-                at = j;
-            }
+        double top, hb[VPDS_MAX_DIM], cb[VPDS_MAX_DIM], hmax = 0, U;
+        size_t at;
+        if (splits == STREAM_SEARCH_BUDGET) return search_diverged(ctx, centre);
+        at = best_box(sm, &top);
         U = top;
-        if (best > U) U = best;
-        if (extra > U) U = extra;
-        if (best < 0 && (U < 0 || sm->n_boxes == 0)) {
+        if (q.best > U) U = q.best;
+        if (q.extra > U) U = q.extra;
+        if (q.best < 0 && (U < 0 || sm->n_boxes == 0)) {
             /* no point of the domain in the region (or none found above the precision) */
             *bound = 0;
             *gy = -1;
             return VPDS_OK;
         }
-        if (U <= best * (1 + tol) || sm->n_boxes == 0) {
+        if (U <= q.best * (1 + q.tol) || sm->n_boxes == 0) {
             *bound = U;
-            *gy = best;
+            *gy = q.best;
             return VPDS_OK;
         }
         /* take the best box out, split it in 2^d */
@@ -292,39 +362,11 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
              * precision of the boundary, covered up to it (as the box's delta) */
             double phi = 0;
             if (ctx->dom->fn && (e = vpdsi_domain_at(ctx->dom, ctx->st, cb, &phi)) != VPDS_OK) return e;
-            if (phi <= 0 && top > extra) extra = top;
+            if (phi <= 0 && top > q.extra) q.extra = top;
             continue;
         }
-        for (j = 0; j < children; j++)
-            for (k = 0; k < d; k++)
-                cs[j * (size_t)d + (size_t)k] = cb[k] + ((j >> k) & 1u ? hb[k] : -hb[k]);
-        if ((e = eval_boxes(sm, ctx, cs, children, hb, gs, ubs)) != VPDS_OK) return e;
-        if (vpdsi_mem_reserve(ctx->mem, (void **)&sm->boxes, &sm->cap_boxes,
-                              (sm->n_boxes + children) * w, sizeof(double)))
-            goto oom;
-        for (j = 0; j < children; j++) {
-            if (gs[j] > best) {
-                best = gs[j];
-                memcpy(y, cs + j * (size_t)d, (size_t)d * sizeof(double));
-            }
-        }
-        for (j = 0; j < children; j++) {
-            double *r;
-            if (ubs[j] < 0) continue; /* outside the domain */
-            if (ubs[j] <= best * (1 + tol)) {
-                /* cannot beat the best by more than the tolerance: keep only its bound */
-                if (ubs[j] > extra) extra = ubs[j];
-                continue;
-            }
-            r = sm->boxes + sm->n_boxes++ * w;
-            r[0] = ubs[j];
-            memcpy(r + 1, cs + j * (size_t)d, (size_t)d * sizeof(double));
-            memcpy(r + 1 + d, hb, (size_t)d * sizeof(double));
-        }
+        if ((e = split_box(sm, ctx, &q, cb, hb)) != VPDS_OK) return e;
     }
-oom:
-    vpdsi_store_error(ctx->st, "out of memory in the stream's search");
-    return VPDS_ERR_OUT_OF_MEMORY;
 }
 
 /* ---- the sample of an event ---- */
@@ -381,49 +423,119 @@ static vpds_status draw_near(const vpdsi_ctx *ctx, double t, const double *y, do
     return VPDS_OK;
 }
 
-vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_min, double t_cap, double *x_out, double *t_out)
+/* The first sample: uniform over the domain (by rejection from the box), at t = +infinity. */
+static vpds_status first_sample(const vpdsi_ctx *ctx, double *x_out, double *t_out)
 {
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_store *st = ctx->st;
+    vpdsi_rng start = *ctx->rng;
+    double x[VPDS_MAX_DIM], r;
     int d = pb->dim, k;
+    long tries;
+    vpds_status e;
+    for (tries = 0;; tries++) {
+        double phi = 0;
+        if (tries == STREAM_FIRST_TRIES) {
+            *ctx->rng = start;
+            vpdsi_store_error(st, "domain: none of %d uniform points of the box has sdf <= 0 (the"
+                              " domain is empty, or too small for a first sample)", STREAM_FIRST_TRIES);
+            return VPDS_ERR_DOMAIN;
+        }
+        for (k = 0; k < d; k++) {
+            double u = pb->lo[k] + vpdsi_rng_unit(ctx->rng) * (pb->hi[k] - pb->lo[k]);
+            x[k] = u > pb->hi[k] ? pb->hi[k] : u;
+        }
+        if (ctx->dom->fn && (e = vpdsi_domain_at(ctx->dom, st, x, &phi)) != VPDS_OK) {
+            *ctx->rng = start;
+            return e;
+        }
+        if (phi <= 0) break;
+    }
+    if ((e = vpdsi_store_radius_at(st, x, &r)) != VPDS_OK) {
+        *ctx->rng = start;
+        return e;
+    }
+    vpdsi_store_append(st, x, r, INFINITY, 0);
+    memcpy(x_out, x, (size_t)d * sizeof(double));
+    *t_out = INFINITY;
+    ctx->stats->accepted++;
+    return VPDS_OK;
+}
+
+/* Whether the top region (record rec, box centre/half, its key) is too coarse for the scale
+ * of its key; then it is replaced by its 2^d children, which inherit the key. */
+static vpds_status split_if_coarse(vpdsi_stream *sm, const vpdsi_ctx *ctx, uint64_t *rec,
+                                   const double *centre, const double *half, int *split)
+{
+    int d = sm->geom.dim, k;
+    double key = rec_key(rec), h = 0, r, L = ctx->st->sizing.lipschitz;
+    unsigned level = (unsigned)rec[1];
+    const uint64_t *c = rec + REC_COORD;
+    uint64_t b, cc[VPDS_MAX_DIM], cr[VPDS_MAX_DIM];
+    vpds_status e;
+    *split = 0;
+    if (!isfinite(key) || level >= sm->max_level) return VPDS_OK;
+    for (k = 0; k < d; k++) h += half[k] * half[k];
+    h = sqrt(h);
+    if ((e = vpdsi_store_radius_at(ctx->st, centre, &r)) != VPDS_OK) return e;
+    if (!(h > STREAM_SPLIT * key * ctx->pb->coverage * (r - L * h) || r <= L * h)) return VPDS_OK;
+    *split = 1;
+    memcpy(cr, c, (size_t)d * sizeof(uint64_t));
+    heap_pop(sm, rec);
+    for (b = 0; b < ((uint64_t)1 << d); b++) {
+        int skip = 0;
+        for (k = 0; k < d; k++) {
+            cc[k] = 2 * cr[k] + ((b >> k) & 1u);
+            if (cc[k] >= (sm->geom.n0[k] << (level + 1))) skip = 1;
+        }
+        if (!skip) heap_push(sm, key, level + 1, cc, -1.0, NULL);
+    }
+    return VPDS_OK;
+}
+
+/* An upper bound of g over the top region and the point y where g = *gy is within the
+ * tolerance of it: the cached maximiser when no sample since lowered g there (samples only
+ * lower g, so the region's bound is unchanged), else a search. */
+static vpds_status bound_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, double key,
+                                const double *centre, const double *half, double *bound,
+                                double *y, double *gy)
+{
+    if (*gy >= 0) {
+        double g1, ub1, zero[VPDS_MAX_DIM] = {0};
+        vpds_status e = eval_boxes(sm, ctx, y, 1, zero, &g1, &ub1);
+        if (e != VPDS_OK) return e;
+        if (g1 == *gy) {
+            *bound = key;
+            return VPDS_OK;
+        }
+    }
+    return search_region(sm, ctx, centre, half, bound, y, gy);
+}
+
+/* The sample of an event at t that covers y: y itself with one radius, else a point drawn
+ * near it (draw_near). */
+static vpds_status event_sample(const vpdsi_ctx *ctx, double t, const double *y, double *x,
+                                double *rx)
+{
+    double ry;
+    vpds_status e = vpdsi_store_radius_at(ctx->st, y, &ry);
+    if (e != VPDS_OK) return e;
+    memcpy(x, y, (size_t)ctx->pb->dim * sizeof(double));
+    *rx = ry;
+    return ctx->pb->two_radii ? draw_near(ctx, t, y, ry, x, rx) : VPDS_OK;
+}
+
+vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_min, double t_cap,
+                              double *x_out, double *t_out)
+{
+    vpdsi_store *st = ctx->st;
+    int d = ctx->pb->dim;
     uint64_t rec[3 + 2 * VPDS_MAX_DIM];
     vpdsi_rng start = *ctx->rng;
     vpds_status e;
     if ((e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
     if ((e = vpdsi_store_reserve(st, 1)) != VPDS_OK) return e;
-    if (st->n == 0) {
-        /* the first sample: uniform over the box, at t = +infinity */
-        double x[VPDS_MAX_DIM], r;
-        long tries;
-        if (t_min >= INFINITY) return VPDS_STREAM_END;
-        for (tries = 0;; tries++) { /* uniform over the domain, by rejection from the box */
-            double phi = 0;
-            if (tries == STREAM_FIRST_TRIES) {
-                *ctx->rng = start;
-                vpdsi_store_error(st, "domain: none of %d uniform points of the box has sdf <= 0 (the"
-                                " domain is empty, or too small for a first sample)", STREAM_FIRST_TRIES);
-                return VPDS_ERR_DOMAIN;
-            }
-            for (k = 0; k < d; k++) {
-                double u = pb->lo[k] + vpdsi_rng_unit(ctx->rng) * (pb->hi[k] - pb->lo[k]);
-                x[k] = u > pb->hi[k] ? pb->hi[k] : u;
-            }
-            if (ctx->dom->fn && (e = vpdsi_domain_at(ctx->dom, st, x, &phi)) != VPDS_OK) {
-                *ctx->rng = start;
-                return e;
-            }
-            if (phi <= 0) break;
-        }
-        if ((e = vpdsi_store_radius_at(st, x, &r)) != VPDS_OK) {
-            *ctx->rng = start;
-            return e;
-        }
-        vpdsi_store_append(st, x, r, INFINITY, 0);
-        memcpy(x_out, x, (size_t)d * sizeof(double));
-        *t_out = INFINITY;
-        ctx->stats->accepted++;
-        return VPDS_OK;
-    }
+    if (st->n == 0) return t_min >= INFINITY ? VPDS_STREAM_END : first_sample(ctx, x_out, t_out);
     if (!sm->active && (e = build_regions(sm, ctx)) != VPDS_OK) return e;
     /* The top region is read, not popped, until every callback of the step has answered: a
      * failing sizing or domain callback then leaves the heap as it was, record for record (a
@@ -432,10 +544,8 @@ vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_m
      * after, in the order of a run that never failed. */
     for (;;) {
         double key, next, centre[VPDS_MAX_DIM], half[VPDS_MAX_DIM], bound, y[VPDS_MAX_DIM], gy;
-        double h = 0, t = 0, x[VPDS_MAX_DIM], rx = 0;
-        int resolved, event;
-        unsigned level;
-        uint64_t *c = rec + REC_COORD;
+        double t = 0, x[VPDS_MAX_DIM], rx = 0;
+        int split, event;
         size_t w = rec_words(sm);
         key = rec_key(sm->heap);
         if (key <= t_min) return VPDS_STREAM_END; /* every region is below: nothing consumed */
@@ -444,66 +554,28 @@ vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_m
             return VPDS_ERR_OUT_OF_MEMORY;
         }
         memcpy(rec, sm->heap, w * sizeof(uint64_t));
-        level = (unsigned)rec[1];
         memcpy(&gy, rec + 2, sizeof gy);
         memcpy(y, rec + REC_COORD + d, (size_t)d * sizeof(double));
         /* the largest key below the top's: one of its children's (the key the top would
          * have after a pop) */
         next = sm->count > 1 ? rec_key(sm->heap + w) : 0.0;
         if (sm->count > 2 && rec_key(sm->heap + 2 * w) > next) next = rec_key(sm->heap + 2 * w);
-        region_box(sm, level, c, centre, half);
-        for (k = 0; k < d; k++) h += half[k] * half[k];
-        h = sqrt(h);
-        if (isfinite(key) && level < sm->max_level) {
-            /* too coarse for the scale of its key: hand its key to its 2^d children */
-            double r;
-            if ((e = vpdsi_store_radius_at(st, centre, &r)) != VPDS_OK) return e;
-            if (h > STREAM_SPLIT * key * pb->coverage * (r - st->sizing.lipschitz * h) ||
-                r <= st->sizing.lipschitz * h) {
-                uint64_t b, cc[VPDS_MAX_DIM];
-                heap_pop(sm, rec);
-                for (b = 0; b < ((uint64_t)1 << d); b++) {
-                    int skip = 0;
-                    for (k = 0; k < d; k++) {
-                        cc[k] = 2 * c[k] + ((b >> k) & 1u);
-                        if (cc[k] >= (sm->geom.n0[k] << (level + 1))) skip = 1;
-                    }
-                    if (!skip) heap_push(sm, key, level + 1, cc, -1.0, NULL);
-                }
-                continue;
-            }
-        }
-        resolved = 0;
-        if (gy >= 0) {
-            /* the cached maximiser still holds if no sample since lowered g there: then the
-             * region's bound is unchanged (samples only lower g) */
-            double g1, ub1, zero[VPDS_MAX_DIM] = {0};
-            if ((e = eval_boxes(sm, ctx, y, 1, zero, &g1, &ub1)) != VPDS_OK) return e;
-            if (g1 == gy) {
-                resolved = 1;
-                bound = key;
-            }
-        }
-        if (!resolved && (e = search_region(sm, ctx, centre, half, &bound, y, &gy)) != VPDS_OK) return e;
+        region_box(sm, (unsigned)rec[1], rec + REC_COORD, centre, half);
+        if ((e = split_if_coarse(sm, ctx, rec, centre, half, &split)) != VPDS_OK) return e;
+        if (split) continue;
+        if ((e = bound_region(sm, ctx, key, centre, half, &bound, y, &gy)) != VPDS_OK) return e;
         /* an event at t = bound (an upper bound of max g), never above the scale at which the
          * set is already maximal (the last event's, or a run's) */
         event = bound >= next;
         if (event) {
-            double ry;
-            t = bound;
-            if (t > t_cap) t = t_cap;
-            if (t > t_min) {
-                if ((e = vpdsi_store_radius_at(st, y, &ry)) != VPDS_OK) return e;
-                memcpy(x, y, (size_t)d * sizeof(double));
-                rx = ry;
-                if (pb->two_radii && (e = draw_near(ctx, t, y, ry, x, &rx)) != VPDS_OK) {
-                    *ctx->rng = start;
-                    return e;
-                }
+            t = bound > t_cap ? t_cap : bound;
+            if (t > t_min && (e = event_sample(ctx, t, y, x, &rx)) != VPDS_OK) {
+                *ctx->rng = start;
+                return e;
             }
         }
         heap_pop(sm, rec);
-        heap_push(sm, bound, level, c, gy, y);
+        heap_push(sm, bound, (unsigned)rec[1], rec + REC_COORD, gy, y);
         if (!event) continue;
         if (t <= t_min) return VPDS_STREAM_END;
         vpdsi_store_append(st, x, rx, t, 0);
