@@ -517,18 +517,106 @@ static size_t tiles_gather(const vpds_tiling *t, const uint64_t *c, const uint64
     return count;
 }
 
+/* Which entry of deps is which dependency of the tile (dep, n_dep of them): each exactly once,
+ * nothing else; order[j] is the entry holding dep[j]. */
+static vpds_status tiles_match_deps(const vpds_tiling *t, uint64_t tile, int phase,
+                                    const vpds_tile_points *deps, size_t n_deps,
+                                    const uint64_t *dep, size_t n_dep, size_t *order, char *msg,
+                                    size_t cap)
+{
+    size_t i, j;
+    for (j = 0; j < n_dep; j++) order[j] = (size_t)-1;
+    for (i = 0; i < n_deps; i++) {
+        const uint64_t *hit = (const uint64_t *)bsearch(&deps[i].tile, dep, n_dep, sizeof *dep,
+                                                        tiles_cmp_u64);
+        if (!hit)
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "deps[%zu].tile = %llu is not a dependency of "
+                         "tile %llu (phase %d; vpds_tiling_deps lists them)", i,
+                         (unsigned long long)deps[i].tile, (unsigned long long)tile, phase);
+        j = (size_t)(hit - dep);
+        if (order[j] != (size_t)-1)
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "deps[%zu].tile = %llu repeats deps[%zu]", i,
+                         (unsigned long long)deps[i].tile, order[j]);
+        if (deps[i].n && (!deps[i].x || !deps[i].r))
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "deps[%zu] (tile %llu): x or r is NULL with "
+                         "n = %zu", i, (unsigned long long)deps[i].tile, deps[i].n);
+        order[j] = i;
+    }
+    for (j = 0; j < n_dep; j++)
+        if (order[j] == (size_t)-1)
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tile %llu (phase %d) needs tile %llu (phase %d) "
+                         "first: it is missing from deps", (unsigned long long)tile, phase,
+                         (unsigned long long)dep[j], vpds_tiling_phase(t, dep[j]));
+    return VPDS_OK;
+}
+
+/* The sampler of one tile, before its fixed points: the tiling's descriptor on the tile's box
+ * and seed, with the whole sizing's bounds and the tiling's scale. */
+static vpds_status tiles_sampler(const vpds_tiling *t, uint64_t tile, const double *lo,
+                                 const double *hi, const vpds_grid *window, vpds_sampler **out,
+                                 char *msg, size_t cap)
+{
+    vpds_desc td = t->desc;
+    char inner[400];
+    vpds_status st;
+    td.lo = lo;
+    td.hi = hi;
+    td.seed = vpds_tiling_seed(t, tile);
+    if (window) {
+        td.sizing_grid = window;
+        td.lipschitz = t->lipschitz;
+    }
+    if ((st = vpds_validate(&td, inner, sizeof inner)) != VPDS_OK)
+        VPDSI_REFUSE(st, "tile %llu: %s", (unsigned long long)tile, inner);
+    if ((st = vpds_create(&td, out)) != VPDS_OK)
+        VPDSI_REFUSE(st, "tile %llu: vpds_create failed (%s)", (unsigned long long)tile,
+                     vpds_status_string(st));
+    /* every tile sees the whole sizing's bounds, whatever part of it it holds: the same cells
+     * and pruning as the batch, and a window gives the points of the whole grid */
+    vpdsi_sampler_share_bounds(*out, t->lipschitz, t->rmin, t->rmax);
+    if (t->scale != 1.0) vpdsi_sampler_start_at(*out, t->scale);
+    return VPDS_OK;
+}
+
+/* The dependencies' samples near the tile become its fixed points. */
+static vpds_status tiles_add_fixed(const vpds_tiling *t, uint64_t tile, const uint64_t *c,
+                                   const uint64_t *dep, size_t n_dep, const size_t *order,
+                                   const vpds_tile_points *deps, const double *lo,
+                                   const double *hi, vpds_sampler *s, size_t *count, char *msg,
+                                   size_t cap)
+{
+    vpdsi_mem m = t->mem;
+    size_t nx = 0, n = tiles_gather(t, c, dep, n_dep, order, deps, lo, hi, NULL, NULL);
+    double *fx = NULL, *fr = NULL;
+    vpds_status st = VPDS_OK;
+    *count = n;
+    if (!n) return VPDS_OK;
+    if (vpdsi_mul_size(n, (size_t)t->dim, &nx) ||
+        !(fx = (double *)vpdsi_mem_alloc(&m, nx * sizeof(double))) ||
+        !(fr = (double *)vpdsi_mem_alloc(&m, n * sizeof(double)))) {
+        if (msg && cap) snprintf(msg, cap, "out of memory for %zu fixed points of tile %llu", n,
+                                 (unsigned long long)tile);
+        st = VPDS_ERR_OUT_OF_MEMORY;
+    } else {
+        tiles_gather(t, c, dep, n_dep, order, deps, lo, hi, fx, fr);
+        if ((st = vpds_add_points(s, fx, fr, n)) != VPDS_OK && msg && cap)
+            snprintf(msg, cap, "tile %llu: %s", (unsigned long long)tile, vpds_last_error(s));
+    }
+    if (fx) vpdsi_mem_free(&m, fx, nx * sizeof(double));
+    if (fr) vpdsi_mem_free(&m, fr, n * sizeof(double));
+    return st;
+}
+
 vpds_status vpds_tile_create(const vpds_tiling *t, uint64_t tile, const vpds_tile_points *deps,
                              size_t n_deps, const vpds_grid *window, vpds_sampler **out,
                              size_t *n_fixed, char *msg, size_t cap)
 {
     vpdsi_mem m;
     uint64_t c[VPDS_MAX_DIM] = {0}, *dep = NULL;
-    size_t *order = NULL, n_dep, i, j, count = 0, dep_bytes, order_bytes, nx = 0;
-    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], *fx = NULL, *fr = NULL;
-    vpds_desc td;
+    size_t *order = NULL, n_dep, count = 0, dep_bytes, order_bytes;
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
     vpds_sampler *s = NULL;
     vpds_status st = VPDS_OK;
-    char inner[400];
     int phase;
     if (msg && cap) msg[0] = 0;
     if (!out) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "out is NULL");
@@ -549,8 +637,6 @@ vpds_status vpds_tile_create(const vpds_tiling *t, uint64_t tile, const vpds_til
     tiles_coords_of(t, tile, c);
     phase = tiles_phase_of(t, c);
     tiles_box_of(t, c, lo, hi);
-
-    /* which entry of deps is which dependency: each exactly once, nothing else */
     m = t->mem;
     dep_bytes = (size_t)tiles_codes(t->dim) * sizeof *dep;
     order_bytes = (size_t)tiles_codes(t->dim) * sizeof *order;
@@ -563,85 +649,15 @@ vpds_status vpds_tile_create(const vpds_tiling *t, uint64_t tile, const vpds_til
         goto done;
     }
     n_dep = tiles_deps_into(t, tile, dep);
-    for (j = 0; j < n_dep; j++) order[j] = (size_t)-1;
-    for (i = 0; i < n_deps; i++) {
-        uint64_t *hit = (uint64_t *)bsearch(&deps[i].tile, dep, n_dep, sizeof *dep, tiles_cmp_u64);
-        if (!hit) {
-            if (msg && cap) snprintf(msg, cap, "deps[%zu].tile = %llu is not a dependency of tile %llu "
-                                     "(phase %d; vpds_tiling_deps lists them)", i,
-                                     (unsigned long long)deps[i].tile, (unsigned long long)tile, phase);
-            st = VPDS_ERR_INVALID_ARGUMENT;
-            goto done;
-        }
-        j = (size_t)(hit - dep);
-        if (order[j] != (size_t)-1) {
-            if (msg && cap) snprintf(msg, cap, "deps[%zu].tile = %llu repeats deps[%zu]", i,
-                                     (unsigned long long)deps[i].tile, order[j]);
-            st = VPDS_ERR_INVALID_ARGUMENT;
-            goto done;
-        }
-        if (deps[i].n && (!deps[i].x || !deps[i].r)) {
-            if (msg && cap) snprintf(msg, cap, "deps[%zu] (tile %llu): x or r is NULL with n = %zu", i,
-                                     (unsigned long long)deps[i].tile, deps[i].n);
-            st = VPDS_ERR_INVALID_ARGUMENT;
-            goto done;
-        }
-        order[j] = i;
-    }
-    for (j = 0; j < n_dep; j++)
-        if (order[j] == (size_t)-1) {
-            if (msg && cap) snprintf(msg, cap, "tile %llu (phase %d) needs tile %llu (phase %d) first: "
-                                     "it is missing from deps", (unsigned long long)tile, phase,
-                                     (unsigned long long)dep[j], vpds_tiling_phase(t, dep[j]));
-            st = VPDS_ERR_INVALID_ARGUMENT;
-            goto done;
-        }
-
-    td = t->desc;
-    td.lo = lo;
-    td.hi = hi;
-    td.seed = vpds_tiling_seed(t, tile);
-    if (window) {
-        td.sizing_grid = window;
-        td.lipschitz = t->lipschitz;
-    }
-    if ((st = vpds_validate(&td, inner, sizeof inner)) != VPDS_OK) {
-        if (msg && cap) snprintf(msg, cap, "tile %llu: %s", (unsigned long long)tile, inner);
+    if ((st = tiles_match_deps(t, tile, phase, deps, n_deps, dep, n_dep, order, msg, cap)) != VPDS_OK ||
+        (st = tiles_sampler(t, tile, lo, hi, window, &s, msg, cap)) != VPDS_OK ||
+        (st = tiles_add_fixed(t, tile, c, dep, n_dep, order, deps, lo, hi, s, &count, msg, cap)) != VPDS_OK)
         goto done;
-    }
-    if ((st = vpds_create(&td, &s)) != VPDS_OK) {
-        if (msg && cap) snprintf(msg, cap, "tile %llu: vpds_create failed (%s)", (unsigned long long)tile,
-                                 vpds_status_string(st));
-        goto done;
-    }
-    /* every tile sees the whole sizing's bounds, whatever part of it it holds: the same cells
-     * and pruning as the batch, and a window gives the points of the whole grid */
-    vpdsi_sampler_share_bounds(s, t->lipschitz, t->rmin, t->rmax);
-    if (t->scale != 1.0) vpdsi_sampler_start_at(s, t->scale);
-
-    count = tiles_gather(t, c, dep, n_dep, order, deps, lo, hi, NULL, NULL);
-    if (count) {
-        if (vpdsi_mul_size(count, (size_t)t->dim, &nx) ||
-            !(fx = (double *)vpdsi_mem_alloc(&m, nx * sizeof(double))) ||
-            !(fr = (double *)vpdsi_mem_alloc(&m, count * sizeof(double)))) {
-            if (msg && cap) snprintf(msg, cap, "out of memory for %zu fixed points of tile %llu", count,
-                                     (unsigned long long)tile);
-            st = VPDS_ERR_OUT_OF_MEMORY;
-            goto done;
-        }
-        tiles_gather(t, c, dep, n_dep, order, deps, lo, hi, fx, fr);
-        if ((st = vpds_add_points(s, fx, fr, count)) != VPDS_OK) {
-            if (msg && cap) snprintf(msg, cap, "tile %llu: %s", (unsigned long long)tile, vpds_last_error(s));
-            goto done;
-        }
-    }
     if (n_fixed) *n_fixed = count;
     *out = s;
     s = NULL;
 done:
     if (s) vpds_destroy(s);
-    if (fx) vpdsi_mem_free(&m, fx, nx * sizeof(double));
-    if (fr) vpdsi_mem_free(&m, fr, count * sizeof(double));
     if (dep) vpdsi_mem_free(&m, dep, dep_bytes);
     if (order) vpdsi_mem_free(&m, order, order_bytes);
     return st;
