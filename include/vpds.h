@@ -41,8 +41,11 @@ extern "C" {
 #define VPDS_VERSION_PATCH 0
 /* The points a seed gives are fixed for one algorithm version; pin it in vpds_desc to keep them.
  * 1: 1.0.0. 2: the two-radii and domain coverage search drops what it used to keep only for
- * want of precision (same guarantees; other points with two radii or a domain). */
-#define VPDS_ALGORITHM_VERSION 2
+ * want of precision (same guarantees; other points with two radii or a domain). 3: a stream
+ * continued after a run splits its regions down to the run's scale before searching them
+ * (versions 1-2 searched the whole box at once and could give up with VPDS_ERR_DOMAIN; other
+ * points for vpds_next after vpds_run). */
+#define VPDS_ALGORITHM_VERSION 3
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 8
 /* Relative tolerance eps of the continuous stream (vpds_next): each t it reports is an upper

@@ -17,6 +17,9 @@
 #define STREAM_FIRST_TRIES 1000000 /* uniform draws for a first sample inside the domain */
 #define STREAM_SEARCH_BUDGET 200000 /* box splits per search before VPDS_ERR_DOMAIN */
 #define STREAM_SPLIT 1.0 /* a region splits while its half-diagonal exceeds STREAM_SPLIT * t * coverage * r */
+/* Version 3: a search of a region that cannot become the next event stops once its bound lies
+ * this far below the best g seen: far enough that it does not return to the top at once */
+#define STREAM_STOP_MARGIN 3e-3
 
 void vpdsi_stream_init(vpdsi_stream *sm)
 {
@@ -305,7 +308,8 @@ static vpds_status search_diverged(const vpdsi_ctx *ctx, const double *centre)
  * tolerance is VPDS_STREAM_DOMAIN_TOLERANCE: on a curved boundary g is often maximal where it
  * varies quadratically along the boundary, so a tolerance eps costs about 1/eps boxes there. */
 static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centre,
-                                 const double *half, double *bound, double *y, double *gy)
+                                 const double *half, double next, double *lb, double *bound,
+                                 double *y, double *gy)
 {
     int d = ctx->pb->dim, k;
     size_t w = 1 + 2 * (size_t)d;
@@ -342,7 +346,11 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
             *gy = -1;
             return VPDS_OK;
         }
-        if (U <= q.best * (1 + q.tol) || sm->n_boxes == 0) {
+        if (lb && q.best > *lb) *lb = q.best;
+        /* resolved to the tolerance; or (version 3) below the next region's key and below the
+         * best g seen since the last sample by the margin: the region goes back into the heap
+         * with its bound, searched again only if it returns to the top */
+        if (U <= q.best * (1 + q.tol) || sm->n_boxes == 0 || (lb && U < next && U <= *lb * (1 - STREAM_STOP_MARGIN))) {
             *bound = U;
             *gy = q.best;
             return VPDS_OK;
@@ -463,32 +471,48 @@ static vpds_status first_sample(const vpdsi_ctx *ctx, double *x_out, double *t_o
 }
 
 /* Whether the top region (record rec, box centre/half, its key) is too coarse for the scale
- * of its key; then it is replaced by its 2^d children, which inherit the key. */
+ * of its key; then it is replaced by its 2^d children. They inherit the key, except that from
+ * version 3 a key of +infinity (a region never searched) is replaced by each child's own upper
+ * bound of g, one evaluation at its centre (eval_boxes): only the regions whose bound reaches
+ * the top are then searched. No event lies above t_cap, so version 3 splits at that scale. */
 static vpds_status split_if_coarse(vpdsi_stream *sm, const vpdsi_ctx *ctx, uint64_t *rec,
-                                   const double *centre, const double *half, int *split)
+                                   const double *centre, const double *half, double t_cap,
+                                   int *split)
 {
-    int d = sm->geom.dim, k;
-    double key = rec_key(rec), h = 0, r, L = ctx->st->sizing.lipschitz;
+    int d = sm->geom.dim, k, v3 = ctx->pb->algorithm >= 3;
+    double key = rec_key(rec), h = 0, r, L = ctx->st->sizing.lipschitz, scale = key;
+    double cs[(1u << VPDS_MAX_DIM) * VPDS_MAX_DIM], hs[VPDS_MAX_DIM];
+    double gs[1u << VPDS_MAX_DIM], ubs[1u << VPDS_MAX_DIM];
     unsigned level = (unsigned)rec[1];
-    const uint64_t *c = rec + REC_COORD;
-    uint64_t b, cc[VPDS_MAX_DIM], cr[VPDS_MAX_DIM];
+    uint64_t b, n = 0, cc[(1u << VPDS_MAX_DIM) * VPDS_MAX_DIM], cr[VPDS_MAX_DIM];
     vpds_status e;
     *split = 0;
-    if (!isfinite(key) || level >= sm->max_level) return VPDS_OK;
+    if (v3 && scale > t_cap) scale = t_cap;
+    if (!isfinite(scale) || level >= sm->max_level) return VPDS_OK;
     for (k = 0; k < d; k++) h += half[k] * half[k];
     h = sqrt(h);
     if ((e = vpdsi_store_radius_at(ctx->st, centre, &r)) != VPDS_OK) return e;
-    if (!(h > STREAM_SPLIT * key * ctx->pb->coverage * (r - L * h) || r <= L * h)) return VPDS_OK;
-    *split = 1;
-    memcpy(cr, c, (size_t)d * sizeof(uint64_t));
-    heap_pop(sm, rec);
+    if (!(h > STREAM_SPLIT * scale * ctx->pb->coverage * (r - L * h) || r <= L * h)) return VPDS_OK;
+    memcpy(cr, rec + REC_COORD, (size_t)d * sizeof(uint64_t));
     for (b = 0; b < ((uint64_t)1 << d); b++) {
+        uint64_t *c = cc + n * (size_t)d;
         int skip = 0;
         for (k = 0; k < d; k++) {
-            cc[k] = 2 * cr[k] + ((b >> k) & 1u);
-            if (cc[k] >= (sm->geom.n0[k] << (level + 1))) skip = 1;
+            c[k] = 2 * cr[k] + ((b >> k) & 1u);
+            if (c[k] >= (sm->geom.n0[k] << (level + 1))) skip = 1;
         }
-        if (!skip) heap_push(sm, key, level + 1, cc, -1.0, NULL);
+        if (!skip) region_box(sm, level + 1, c, cs + n++ * (size_t)d, hs);
+    }
+    /* every callback answers before the heap changes (vpdsi_stream_next) */
+    if (v3 && !isfinite(key) && n > 0) {
+        for (k = 0; k < d; k++) hs[k] = 0.5 * half[k];
+        if ((e = eval_boxes(sm, ctx, cs, (size_t)n, hs, gs, ubs)) != VPDS_OK) return e;
+    }
+    *split = 1;
+    heap_pop(sm, rec);
+    for (b = 0; b < n; b++) {
+        double kb = v3 && !isfinite(key) ? ubs[b] : key;
+        heap_push(sm, kb < 0 ? 0.0 : kb, level + 1, cc + b * (size_t)d, -1.0, NULL);
     }
     return VPDS_OK;
 }
@@ -496,20 +520,25 @@ static vpds_status split_if_coarse(vpdsi_stream *sm, const vpdsi_ctx *ctx, uint6
 /* An upper bound of g over the top region and the point y where g = *gy is within the
  * tolerance of it: the cached maximiser when no sample since lowered g there (samples only
  * lower g, so the region's bound is unchanged), else a search. */
-static vpds_status bound_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, double key,
-                                const double *centre, const double *half, double *bound,
-                                double *y, double *gy)
+static vpds_status bound_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, double key, double next,
+                                double *lb, const double *centre, const double *half,
+                                double *bound, double *y, double *gy)
 {
-    if (*gy >= 0) {
+    int v3 = ctx->pb->algorithm >= 3;
+    double tol = ctx->dom->fn ? VPDS_STREAM_DOMAIN_TOLERANCE : VPDS_STREAM_TOLERANCE;
+    /* version 3 stops a search below the next key, so a cached point is the region's
+     * maximiser only when it is within the tolerance of the key */
+    if (*gy >= 0 && (!v3 || *gy * (1 + tol) >= key)) {
         double g1, ub1, zero[VPDS_MAX_DIM] = {0};
         vpds_status e = eval_boxes(sm, ctx, y, 1, zero, &g1, &ub1);
         if (e != VPDS_OK) return e;
         if (g1 == *gy) {
             *bound = key;
+            if (v3 && g1 > *lb) *lb = g1;
             return VPDS_OK;
         }
     }
-    return search_region(sm, ctx, centre, half, bound, y, gy);
+    return search_region(sm, ctx, centre, half, next, v3 ? lb : NULL, bound, y, gy);
 }
 
 /* The sample of an event at t that covers y: y itself with one radius, else a point drawn
@@ -532,6 +561,10 @@ vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_m
     int d = ctx->pb->dim;
     uint64_t rec[3 + 2 * VPDS_MAX_DIM];
     vpdsi_rng start = *ctx->rng;
+    /* version 3: the largest g seen since the last sample, a lower bound of max g; kept in
+     * the stream (committed after each step that succeeds), so that a call that fails and its
+     * retry take the steps of a call that never failed */
+    double lb = sm->lb_n == st->n ? sm->lb : -1;
     vpds_status e;
     if ((e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
     if ((e = vpdsi_store_reserve(st, 1)) != VPDS_OK) return e;
@@ -544,7 +577,7 @@ vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_m
      * after, in the order of a run that never failed. */
     for (;;) {
         double key, next, centre[VPDS_MAX_DIM], half[VPDS_MAX_DIM], bound, y[VPDS_MAX_DIM], gy;
-        double t = 0, x[VPDS_MAX_DIM], rx = 0;
+        double t = 0, x[VPDS_MAX_DIM], rx = 0, step_lb;
         int split, event;
         size_t w = rec_words(sm);
         key = rec_key(sm->heap);
@@ -561,9 +594,11 @@ vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_m
         next = sm->count > 1 ? rec_key(sm->heap + w) : 0.0;
         if (sm->count > 2 && rec_key(sm->heap + 2 * w) > next) next = rec_key(sm->heap + 2 * w);
         region_box(sm, (unsigned)rec[1], rec + REC_COORD, centre, half);
-        if ((e = split_if_coarse(sm, ctx, rec, centre, half, &split)) != VPDS_OK) return e;
+        if ((e = split_if_coarse(sm, ctx, rec, centre, half, t_cap, &split)) != VPDS_OK) return e;
         if (split) continue;
-        if ((e = bound_region(sm, ctx, key, centre, half, &bound, y, &gy)) != VPDS_OK) return e;
+        step_lb = lb;
+        if ((e = bound_region(sm, ctx, key, next, &step_lb, centre, half, &bound, y, &gy)) != VPDS_OK)
+            return e;
         /* an event at t = bound (an upper bound of max g), never above the scale at which the
          * set is already maximal (the last event's, or a run's) */
         event = bound >= next;
@@ -576,6 +611,9 @@ vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_m
         }
         heap_pop(sm, rec);
         heap_push(sm, bound, (unsigned)rec[1], rec + REC_COORD, gy, y);
+        lb = step_lb;
+        sm->lb = lb;
+        sm->lb_n = st->n;
         if (!event) continue;
         if (t <= t_min) return VPDS_STREAM_END;
         vpdsi_store_append(st, x, rx, t, 0);

@@ -16,6 +16,8 @@ typedef struct vpdsi_stream {
     double *boxes;                 /* the search inside one region: key, centre, half sides */
     size_t n_boxes, cap_boxes;
     double *buf;                   /* centres and radii of one split */
+    double lb;                     /* version 3: the largest g seen while the store held lb_n */
+    size_t lb_n;                   /* samples (lb is -1 once a sample is added) */
     size_t cap_buf;
 } vpdsi_stream;
 

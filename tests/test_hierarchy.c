@@ -175,6 +175,35 @@ static void check_run_and_refine(const setup *c, double (*sizing)(const double *
     vpds_destroy(s);
 }
 
+/* A stream continued after a maximal 3D run of 6,500 samples: versions 1-2 searched the whole
+ * box for the first event (23 s here, and VPDS_ERR_DOMAIN "did not converge" at r = 0.03);
+ * version 3 splits the regions at the run's scale. Each prefix stays conflict-free, and the
+ * set stays maximal at the last event's t. */
+static void check_stream_after_3d_run(void)
+{
+    setup c;
+    vpds_sampler *s;
+    double x[3], t, prev = 1.0;
+    size_t n;
+    int i;
+    c.dim = 3; c.periodic = NULL; c.rule = VPDS_RULE_SMALLER; c.inhibition = 1; c.coverage = 1;
+    s = make(&c, NULL, 0, 0.05, 31);
+    CHECK(vpds_run(s) == VPDS_OK);
+    n = vpds_count(s);
+    for (i = 0; i < 50; i++) {
+        vpds_status st = vpds_next(s, 0, x, &t);
+        CHECK_MSG(st == VPDS_OK, "event %d after a 3D run: %s (%s)", i, vpds_status_string(st),
+                  vpds_last_error(s));
+        if (st != VPDS_OK) break;
+        CHECK(t <= prev && t > 0.9);
+        prev = t;
+    }
+    CHECK(vpds_count(s) == n + 50);
+    CHECK(conflicts(&c, vpds_points(s), vpds_radii(s), vpds_count(s), prev, VPDS_STREAM_TOLERANCE) == 0);
+    CHECK(gaps(&c, vpds_points(s), vpds_radii(s), vpds_count(s), prev, NULL, 0.05, 3000, 17u) == 0);
+    vpds_destroy(s);
+}
+
 int main(void)
 {
     static const int both[2] = {1, 1}, first[2] = {1, 0}, all3[3] = {1, 1, 1};
@@ -202,6 +231,7 @@ int main(void)
     check_stream(&c, NULL, 0, 0.1, 400);
     c.periodic = all3; c.inhibition = 0.5;
     check_stream(&c, NULL, 0, 0.1, 300);
+    check_stream_after_3d_run();
 
     /* Algorithm 1 with two radii and periodic axes, then refinement and a stream after it */
     c.dim = 2; c.periodic = NULL; c.inhibition = 0.5; c.coverage = 1;

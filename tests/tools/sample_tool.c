@@ -5,7 +5,8 @@
  *   mild (0.04 + 0.04 x) or steep (0.05 + 0.2 x, the fuzzers' ramp); weighted: 1 for the
  *   weighted-bias-free process (Eq. 12)
  *   KEY=VALUE: inhibition=F (two radii), periodic=MASK (bit k: axis k), domain=ball (the ball
- *   of radius 0.4 about the box centre), version=N (desc.algorithm_version) */
+ *   of radius 0.4 about the box centre), version=N (desc.algorithm_version), run=0 (no
+ *   vpds_run: a stream from empty), stream=N (then N events of vpds_next, t_min 0) */
 #include "vpds.h"
 #include <math.h>
 #include <stdio.h>
@@ -36,7 +37,8 @@ int main(int argc, char **argv)
     vpds_sampler *s;
     vpds_status st;
     double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
-    int dim, k, periodic[VPDS_MAX_DIM] = {0}, positional = argc, a;
+    int dim, k, periodic[VPDS_MAX_DIM] = {0}, positional = argc, a, run = 1;
+    long events = 0, e;
     FILE *f;
     long long hdr[2];
     vpds_stats stats;
@@ -87,6 +89,10 @@ int main(int argc, char **argv)
         } else if (!strcmp(argv[a], "domain=ball")) {
             d.domain = ball;
             d.domain_user = &dim;
+        } else if (!strncmp(argv[a], "run=", 4)) {
+            run = atoi(v);
+        } else if (!strncmp(argv[a], "stream=", 7)) {
+            events = atol(v);
         } else if (!strncmp(argv[a], "version=", 8)) {
             d.algorithm_version = (uint32_t)atoi(v);
         } else {
@@ -100,10 +106,21 @@ int main(int argc, char **argv)
         fprintf(stderr, "vpds_create: %s: %s\n", vpds_status_string(st), msg);
         return 1;
     }
-    while ((st = vpds_run(s)) == VPDS_PAUSED) {}
+    st = VPDS_OK;
+    while (run && (st = vpds_run(s)) == VPDS_PAUSED) {}
     if (st != VPDS_OK) {
         fprintf(stderr, "vpds_run: %s: %s\n", vpds_status_string(st), vpds_last_error(s));
         return 1;
+    }
+    for (e = 0; e < events; e++) {
+        double x[VPDS_MAX_DIM], t;
+        st = vpds_next(s, 0.0, x, &t);
+        if (st == VPDS_STREAM_END) break;
+        if (st != VPDS_OK) {
+            fprintf(stderr, "vpds_next (event %ld): %s: %s\n", e, vpds_status_string(st),
+                    vpds_last_error(s));
+            return 1;
+        }
     }
     stats = vpds_get_stats(s);
     hdr[0] = (long long)vpds_count(s);

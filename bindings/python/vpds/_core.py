@@ -112,7 +112,8 @@ class PoissonDisk:
       progress:   a tqdm bar during fill_space (if tqdm is installed).
       algorithm_version: pin the points a seed gives (None or 0: the library's current
                   version, `vpds.ALGORITHM_VERSION`); 1 reproduces worlds made before
-                  version 2 changed the coverage search of two radii.
+                  version 2 changed the coverage search of two radii, 2 streams made
+                  before version 3 changed the stream after a run.
     Results are numpy arrays of shape (n, d) (copies: they outlive the sampler).
     """
 
