@@ -1,6 +1,5 @@
 #include "kdtree.h"
-#include "rules.h"
-#include "torus.h"
+#include "proximity.h"
 #include <math.h>
 #include <string.h>
 
@@ -197,17 +196,12 @@ int32_t vpdsi_kd_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, cons
         if (nd->left < 0) {
             int32_t i;
             for (i = nd->head; i >= 0; i = t->next[i]) {
-                double d2, f = conflict_reach(s, i, ry, rule, scale);
-                d2 = dist2(y, s->x + (size_t)i * d, d);
-                if (lipschitz >= 0 && !(s->flags[i] & VPDSI_SAMPLE_OWN_RADIUS)) {
-                    double gap = fabs(ry - s->r[i]);
-                    double allowed = lipschitz * sqrt(d2) * (1 + 1e-9) + 1e-12 * (ry + s->r[i]);
-                    if (gap > allowed) {
-                        *witness = i;
-                        return -2;
-                    }
+                int hit = vpdsi_prox_conflict(s, i, d, t->period, y, ry, rule, scale, lipschitz);
+                if (hit == -2) {
+                    *witness = i;
+                    return -2;
                 }
-                if (d2 < f * f) return i;
+                if (hit) return i;
             }
         } else {
             int near = y[nd->axis] < nd->split;
@@ -226,46 +220,6 @@ static int push_index(vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap, i
     return 0;
 }
 
-/* Lower bound of the farthest distance, along one axis, from a point of [a, b] to the nearest
- * sub-interval (centres c0, c1 of half-width w). */
-static double far_bound(double a, double b, double c0, double c1, double w, double P)
-{
-    double g0 = vpdsi_axis_gap(c0, a, b, P), g1 = vpdsi_axis_gap(c1, a, b, P);
-    return w + (g0 < g1 ? g0 : g1);
-}
-
-/* Centres (c0, c1) and half-width w of the sub-intervals gather measures against, per axis. */
-static void gather_centres(int d, const double *lo, const double *hi, int split, double *c0,
-                           double *c1, double *w)
-{
-    int k;
-    for (k = 0; k < d; k++) {
-        double mid = 0.5 * (lo[k] + hi[k]);
-        if (split) {
-            c0[k] = 0.5 * (lo[k] + mid);
-            c1[k] = 0.5 * (mid + hi[k]);
-            w[k] = 0.25 * (hi[k] - lo[k]);
-        } else {
-            c0[k] = c1[k] = mid;
-            w[k] = 0.5 * (hi[k] - lo[k]);
-        }
-    }
-}
-
-/* Gather's test of one sample: it may cover a whole sub-box at reach scale * f(r(x), r_hi). */
-static int may_cover(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i, const double *c0,
-                     const double *c1, const double *w, double r_hi, int rule, double scale)
-{
-    const double *x = s->x + (size_t)i * (size_t)t->dim;
-    double f = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_hi), need = 0;
-    int k;
-    for (k = 0; k < t->dim; k++) {
-        double fb = far_bound(x[k], x[k], c0[k], c1[k], w[k], t->period[k]);
-        need += fb * fb;
-    }
-    return !(need > f * f);
-}
-
 int vpdsi_kd_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *lo,
                     const double *hi, double r_hi, int rule, double scale, int split,
                     vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap)
@@ -274,7 +228,7 @@ int vpdsi_kd_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const doub
     int top = 0, d = t->dim, k;
     double c0[VPDS_MAX_DIM], c1[VPDS_MAX_DIM], w[VPDS_MAX_DIM];
     if (t->n_nodes == 0) return 0;
-    gather_centres(d, lo, hi, split, c0, c1, w);
+    vpdsi_prox_gather_centres(d, lo, hi, split, c0, c1, w);
     stack[top++] = 0;
     while (top > 0) {
         int32_t n = stack[--top];
@@ -282,14 +236,14 @@ int vpdsi_kd_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const doub
         const double *blo = BOX_LO(t, n), *bhi = BOX_HI(t, n);
         double reach = scale * vpdsi_rule_f((vpds_rule)rule, nd->rmax, r_hi), need = 0;
         for (k = 0; k < d; k++) {
-            double f = far_bound(blo[k], bhi[k], c0[k], c1[k], w[k], t->period[k]);
+            double f = vpdsi_prox_far_bound(blo[k], bhi[k], c0[k], c1[k], w[k], t->period[k]);
             need += f * f;
         }
         if (need > reach * reach) continue;
         if (nd->left < 0) {
             int32_t i;
             for (i = nd->head; i >= 0; i = t->next[i])
-                if (may_cover(t, s, i, c0, c1, w, r_hi, rule, scale) &&
+                if (vpdsi_prox_may_cover(s, i, t->dim, t->period, c0, c1, w, r_hi, rule, scale) &&
                     push_index(m, out, count, cap, i))
                     return -1;
         } else {
@@ -459,9 +413,9 @@ int vpdsi_kd_list_box_covered(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
 {
     double c0[VPDS_MAX_DIM], c1[VPDS_MAX_DIM], w[VPDS_MAX_DIM];
     size_t j;
-    gather_centres(t->dim, lo, hi, 0, c0, c1, w);
+    vpdsi_prox_gather_centres(t->dim, lo, hi, 0, c0, c1, w);
     for (j = 0; j < n; j++)
-        if (may_cover(t, s, cand[j], c0, c1, w, r_hi, rule, scale) &&
+        if (vpdsi_prox_may_cover(s, cand[j], t->dim, t->period, c0, c1, w, r_hi, rule, scale) &&
             covers_box(t, s, cand[j], lo, hi, r_lo, rule, scale))
             return 1;
     return 0;

@@ -35,11 +35,8 @@ void vpdsi_mps_release_cells(vpdsi_mps *m, vpdsi_store *st)
 {
     vpdsi_cells_release(&m->run.cur, st->mem);
     vpdsi_cells_release(&m->run.next, st->mem);
-    if (st->grid_mode) {
-        /* done at this scale: keep the samples, drop the accelerator (rebuilt on the next run) */
-        vpdsi_bgrid_release(&st->grid, st->mem);
-        st->grid_mode = 0;
-    }
+    /* done at this scale: keep the samples, drop the accelerator (rebuilt on the next run) */
+    vpdsi_store_drop_index(st);
 }
 
 void vpdsi_mps_release(vpdsi_mps *m, vpdsi_store *st)
@@ -92,6 +89,11 @@ static vpds_status choose_index(vpdsi_mps *m, const vpdsi_ctx *ctx, int keep_tre
         return VPDS_OK;
     }
     vpdsi_bgrid_release(&st->grid, ctx->mem);
+    /* a variable radius with one radius on open axes: the octave grid (the two-radii search
+     * and the domain's reads the kd-tree, which then lags behind until synced) */
+    if (st->sizing.kind != VPDSI_SIZING_CONSTANT && pb->dim <= 3 && !pb->two_radii &&
+        !pb->any_periodic && !keep_tree && !ctx->dom->fn)
+        return vpdsi_store_use_ogrid(st, run->t * pb->inhibition * st->sizing.rmax);
     return vpdsi_store_sync_tree(st);
 }
 
@@ -297,9 +299,8 @@ static vpds_status judge_dart(vpdsi_mps *m, const vpdsi_ctx *ctx, const double *
     if (st->grid_mode) {
         hit = vpdsi_bgrid_conflict(&st->grid, st->x, y, scale * st->sizing.radius);
     } else {
-        vpdsi_kd_samples view = vpdsi_store_view(st);
-        hit = vpdsi_kd_conflict(&st->tree, &view, y, ry, (int)pb->rule, scale,
-                                varying ? st->sizing.lipschitz : -1.0, &witness);
+        hit = vpdsi_store_conflict(st, y, ry, (int)pb->rule, scale,
+                                   varying ? st->sizing.lipschitz : -1.0, &witness);
     }
     if (hit == -2) return lipschitz_broken(st, y, ry, witness);
     if (hit != -1) return VPDS_OK; /* conflicts with sample hit */
@@ -463,15 +464,14 @@ static vpds_status gather_near(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_store *st = ctx->st;
     double scale = m->run.t * (pb->two_radii ? pb->coverage : pb->inhibition);
-    vpdsi_kd_samples view = vpdsi_store_view(st);
     m->n_cand = 0;
     if (st->grid_mode) {
         uint64_t base[VPDS_MAX_DIM];
         int k;
         for (k = 0; k < pb->dim; k++) base[k] = c[k] >> level; /* the base cell holding this one */
         m->n_cand = vpdsi_bgrid_near(&st->grid, vpdsi_bgrid_index(&st->grid, base), m->cand);
-    } else if (vpdsi_kd_gather(&st->tree, &view, lo, hi, r_hi, (int)pb->rule, scale, split,
-                               ctx->mem, &m->cand, &m->n_cand, &m->cap_cand)) {
+    } else if (vpdsi_store_gather(st, lo, hi, r_hi, (int)pb->rule, scale, split, &m->cand,
+                                  &m->n_cand, &m->cap_cand)) {
         vpdsi_store_error(st, "out of memory gathering the samples near a cell");
         return VPDS_ERR_OUT_OF_MEMORY;
     }

@@ -25,6 +25,7 @@ void vpdsi_store_release(vpdsi_store *st)
 {
     vpdsi_mem *m = st->mem;
     vpdsi_bgrid_release(&st->grid, m);
+    vpdsi_ogrid_release(&st->ogrid, m);
     vpdsi_kd_release(&st->tree, m);
     vpdsi_mem_free(m, st->x, st->cap_x * sizeof(double));
     vpdsi_mem_free(m, st->r, st->cap_r * sizeof(double));
@@ -97,7 +98,9 @@ vpds_status vpdsi_store_reserve(vpdsi_store *st, size_t more)
         vpdsi_mem_reserve(m, (void **)&st->r, &st->cap_r, need, sizeof(double)) ||
         vpdsi_mem_reserve(m, (void **)&st->t, &st->cap_t, need, sizeof(double)) ||
         vpdsi_mem_reserve(m, (void **)&st->flags, &st->cap_flags, need, 1) ||
-        (!st->grid_mode && vpdsi_kd_reserve(&st->tree, m, need, need - st->tree_n))) {
+        (!st->grid_mode && !st->ogrid_mode &&
+         vpdsi_kd_reserve(&st->tree, m, need, need - st->tree_n)) ||
+        (st->ogrid_mode && vpdsi_ogrid_reserve(&st->ogrid, m, need, more))) {
         vpdsi_store_error(st, "out of memory for %zu samples", need);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
@@ -120,11 +123,55 @@ vpds_status vpdsi_store_use_tree(vpdsi_store *st)
 {
     vpds_status e = vpdsi_store_sync_tree(st);
     if (e != VPDS_OK) return e;
-    if (st->grid_mode) {
-        st->grid_mode = 0;
-        vpdsi_bgrid_release(&st->grid, st->mem);
-    }
+    vpdsi_store_drop_index(st);
     return VPDS_OK;
+}
+
+void vpdsi_store_drop_index(vpdsi_store *st)
+{
+    if (st->grid_mode) vpdsi_bgrid_release(&st->grid, st->mem);
+    if (st->ogrid_mode) vpdsi_ogrid_release(&st->ogrid, st->mem);
+    st->grid_mode = st->ogrid_mode = 0;
+}
+
+vpds_status vpdsi_store_use_ogrid(vpdsi_store *st, double top)
+{
+    vpdsi_kd_samples v = vpdsi_store_view(st);
+    size_t i;
+    vpdsi_store_drop_index(st);
+    if (vpdsi_ogrid_setup(&st->ogrid, st->dim, st->lo, st->hi, top)) {
+        vpdsi_store_error(st, "the octave grid holds dim <= 3, not %d", st->dim);
+        return VPDS_ERR_INVALID_ARGUMENT;
+    }
+    if (vpdsi_ogrid_reserve(&st->ogrid, st->mem, st->n, st->n)) {
+        vpdsi_ogrid_release(&st->ogrid, st->mem);
+        vpdsi_store_error(st, "out of memory indexing %zu samples", st->n);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < st->n; i++) vpdsi_ogrid_insert(&st->ogrid, &v, (int32_t)i);
+    st->ogrid_mode = 1;
+    return VPDS_OK;
+}
+
+int32_t vpdsi_store_conflict(const vpdsi_store *st, const double *y, double ry, int rule,
+                             double scale, double lipschitz, int32_t *witness)
+{
+    vpdsi_kd_samples v = vpdsi_store_view(st);
+    if (st->ogrid_mode)
+        return vpdsi_ogrid_conflict(&st->ogrid, &v, y, ry, rule, scale, lipschitz, witness);
+    return vpdsi_kd_conflict(&st->tree, &v, y, ry, rule, scale, lipschitz, witness);
+}
+
+int vpdsi_store_gather(const vpdsi_store *st, const double *lo, const double *hi, double r_hi,
+                       int rule, double scale, int split, int32_t **out, size_t *count,
+                       size_t *cap)
+{
+    vpdsi_kd_samples v = vpdsi_store_view(st);
+    if (st->ogrid_mode)
+        return vpdsi_ogrid_gather(&st->ogrid, &v, lo, hi, r_hi, rule, scale, split, st->mem, out,
+                                  count, cap);
+    return vpdsi_kd_gather(&st->tree, &v, lo, hi, r_hi, rule, scale, split, st->mem, out, count,
+                           cap);
 }
 
 void vpdsi_store_append(vpdsi_store *st, const double *x, double r, double t, uint8_t flags)
@@ -136,6 +183,9 @@ void vpdsi_store_append(vpdsi_store *st, const double *x, double r, double t, ui
     st->n++;
     if (st->grid_mode) {
         st->grid.cell[vpdsi_bgrid_locate(&st->grid, x)] = (int32_t)(st->n - 1);
+    } else if (st->ogrid_mode) {
+        vpdsi_kd_samples v = vpdsi_store_view(st);
+        vpdsi_ogrid_insert(&st->ogrid, &v, (int32_t)(st->n - 1));
     } else {
         vpdsi_kd_samples v = vpdsi_store_view(st);
         vpdsi_kd_insert(&st->tree, &v, (int32_t)(st->n - 1));

@@ -6,6 +6,7 @@
 #define VPDS_STORE_H
 #include "bgrid.h"
 #include "kdtree.h"
+#include "ogrid.h"
 #include "sizing.h"
 
 typedef struct vpdsi_store {
@@ -23,6 +24,8 @@ typedef struct vpdsi_store {
     size_t tree_n;
     vpdsi_bgrid grid;    /* the uniform-radius accelerator, in use when grid_mode */
     int grid_mode;
+    vpdsi_ogrid ogrid;   /* the variable-radius index, in use when ogrid_mode */
+    int ogrid_mode;
     char err[512];
 } vpdsi_store;
 
@@ -48,6 +51,19 @@ vpds_status vpdsi_store_reserve(vpdsi_store *st, size_t more);
 vpds_status vpdsi_store_sync_tree(vpdsi_store *st);
 /* Append and index a sample (after vpdsi_store_reserve). */
 void vpdsi_store_append(vpdsi_store *st, const double *x, double r, double t, uint8_t flags);
+/* Index the samples (dim <= 3) with the octave grid (radii up to about top) until use_tree or
+ * drop_index; queries then go through vpdsi_store_conflict and vpdsi_store_gather. On failure
+ * the store is left with no accelerator (the kd-tree, maybe lagging). */
+vpds_status vpdsi_store_use_ogrid(vpdsi_store *st, double top);
+/* Done at a scale: drop the background or octave grid (the kd-tree lags behind, synced when
+ * next needed). */
+void vpdsi_store_drop_index(vpdsi_store *st);
+/* vpdsi_kd_conflict / vpdsi_kd_gather on the index in use (kd-tree or octave grid). */
+int32_t vpdsi_store_conflict(const vpdsi_store *st, const double *y, double ry, int rule,
+                             double scale, double lipschitz, int32_t *witness);
+int vpdsi_store_gather(const vpdsi_store *st, const double *lo, const double *hi, double r_hi,
+                       int rule, double scale, int split, int32_t **out, size_t *count,
+                       size_t *cap);
 /* Leave grid mode: the kd-tree takes over (it must hold every sample first). */
 vpds_status vpdsi_store_use_tree(vpdsi_store *st);
 /* Fixed points (vpds_add_points, after its checks): stored in the caller's order, each wrapped

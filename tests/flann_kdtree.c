@@ -5,6 +5,7 @@
  * within a relative 1e-5 of a query's boundary are left out of the comparison. */
 #include "check.h"
 #include "kdtree.h"
+#include "ogrid.h"
 #include "mem.h"
 #include "rules.h"
 #include <flann/flann.h>
@@ -62,6 +63,11 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
     int q, k, rule;
     double rmax = 0;
     char *mark = (char *)calloc((size_t)n, 1);
+    vpdsi_ogrid og;
+    int use_og = dim <= 3;
+    int32_t *out2 = NULL;
+    size_t cnt2 = 0, cap2 = 0;
+    double box_lo[6] = {0}, box_hi[6] = {1, 1, 1, 1, 1, 1};
     vpdsi_mem_init(&m, NULL);
     vpdsi_kd_init(&t, dim);
     memset(flags, 0, sizeof flags);
@@ -70,6 +76,12 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
     for (i = 0; i < n; i++) {
         vpdsi_kd_insert(&t, &s, i);
         if (r[i] > rmax) rmax = r[i];
+    }
+    /* the octave grid over the same samples (their box: [0, 1]^dim) */
+    if (use_og) {
+        CHECK(vpdsi_ogrid_setup(&og, dim, box_lo, box_hi, rmax) == 0);
+        CHECK(vpdsi_ogrid_reserve(&og, &m, (size_t)n, (size_t)n) == 0);
+        for (i = 0; i < n; i++) vpdsi_ogrid_insert(&og, &s, i);
     }
     f.params = DEFAULT_FLANN_PARAMETERS;
     f.params.algorithm = FLANN_INDEX_KDTREE_SINGLE;
@@ -106,6 +118,7 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
         for (rule = VPDS_RULE_PRIOR; rule <= VPDS_RULE_SMALLER; rule++) {
             int32_t w, ours = vpdsi_kd_conflict(&t, &s, p, rp, rule, 1.0, -1.0, &w) >= 0, ref = 0,
                        ambiguous = 0;
+            int32_t grid = use_og ? vpdsi_ogrid_conflict(&og, &s, p, rp, rule, 1.0, -1.0, &w) >= 0 : ours;
             for (j = 0; j < nf; j++) {
                 int id = f.idx[j];
                 double fr = vpdsi_rule_f((vpds_rule)rule, r[id], rp), d2 = dist2(p, x + id * dim, dim);
@@ -114,6 +127,9 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
             }
             if (ours != ref && !ambiguous)
                 CHECK_MSG(0, "%s: conflict rule %d: ours %d, FLANN %d", name, rule, ours, ref);
+            if (grid != ref && !ambiguous)
+                CHECK_MSG(0, "%s: octave grid conflict rule %d: ours %d, FLANN %d", name, rule, grid, ref);
+            CHECK_MSG(grid == ours, "%s: octave grid and kd-tree conflicts differ (rule %d)", name, rule);
         }
         /* each rule's box coverage primitive on a box around p */
         {
@@ -131,6 +147,26 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
                 cnt = 0;
                 CHECK(vpdsi_kd_gather(&t, &s, lo, hi, rp, rule, 1.0, 0, &m, &out, &cnt, &cap) == 0);
                 ours = vpdsi_kd_box_covered(&t, &s, out, cnt, lo, hi, rp, rule, 1.0);
+                if (use_og) {
+                    /* the grid gathers the same candidates, in another order */
+                    int split;
+                    for (split = 0; split < 2; split++) {
+                        size_t a;
+                        cnt = cnt2 = 0;
+                        CHECK(vpdsi_kd_gather(&t, &s, lo, hi, rp, rule, 1.0, split, &m, &out, &cnt, &cap) == 0);
+                        CHECK(vpdsi_ogrid_gather(&og, &s, lo, hi, rp, rule, 1.0, split, &m, &out2, &cnt2, &cap2) == 0);
+                        memset(mark, 0, (size_t)n);
+                        for (a = 0; a < cnt; a++) mark[out[a]] |= 1;
+                        for (a = 0; a < cnt2; a++) mark[out2[a]] |= 2;
+                        for (a = 0; a < (size_t)n; a++)
+                            if (mark[a] == 1 || mark[a] == 2) break;
+                        CHECK_MSG(a == (size_t)n && cnt == cnt2, "%s: octave grid gather (rule %d, "
+                                  "split %d) differs from the kd-tree's: %zu against %zu", name, rule,
+                                  split, cnt2, cnt);
+                    }
+                    cnt = 0;
+                    CHECK(vpdsi_kd_gather(&t, &s, lo, hi, rp, rule, 1.0, 0, &m, &out, &cnt, &cap) == 0);
+                }
                 for (j = 0; j < nf; j++) {
                     int id = f.idx[j];
                     double fr = vpdsi_rule_f((vpds_rule)rule, r[id], rp);
@@ -147,6 +183,8 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
     free(f.idx);
     free(f.dist);
     vpdsi_mem_free(&m, out, cap * sizeof *out);
+    vpdsi_mem_free(&m, out2, cap2 * sizeof *out2);
+    if (use_og) vpdsi_ogrid_release(&og, &m);
     free(mark);
     vpdsi_kd_release(&t, &m);
     CHECK(m.held == 0);
@@ -182,6 +220,12 @@ int main(void)
             for (k = 0; k < d; k++) x[i * d + k] = (double)((i / (k + 1)) % 5) / 4.0;
         snprintf(name, sizeof name, "lattice %dD", d);
         check_set(name, d, n, x, r);
+        /* radii over three octaves of ten: every level of the octave grid in use */
+        for (i = 0; i < n * d; i++) x[i] = unit();
+        for (i = 0; i < n; i++) r[i] = 0.0002 * pow(1000.0, unit());
+        snprintf(name, sizeof name, "multi-scale %dD", d);
+        check_set(name, d, n, x, r);
+        for (i = 0; i < n; i++) r[i] = 0.01 + 0.1 * unit();
     }
     printf("FLANN comparisons: %d points agreed, %d within float rounding of a boundary\n",
            compared, skipped);

@@ -1,0 +1,47 @@
+/* The octave grid: the neighbour index of a variable radius in 1-3D. A sample of radius r is
+ * filed at the level whose cell side s = top * 2^-level is the smallest at or above r, in one
+ * hash table of (level, cell) keys. A query visits, level by level, the cells within that
+ * level's reach (from the largest radius it holds, so no bound on L is assumed) and only the
+ * levels whose bounding box it meets; near a point an L-Lipschitz sizing fills two or three
+ * levels, so a query reads a few cells of each where the kd-tree walks from its root. */
+#ifndef VPDS_OGRID_H
+#define VPDS_OGRID_H
+#include "kdtree.h"
+
+#define VPDSI_OGRID_LEVELS 40
+#define VPDSI_OGRID_BITS 19 /* cell coordinate bits per axis (dim <= 3) */
+
+typedef struct vpdsi_ogrid_level {
+    double side, inv, rmax;        /* cell side and its inverse; largest radius filed here */
+    double lo[3], hi[3];           /* bounding box of its samples */
+    uint64_t clo[3], chi[3];       /* ... in cells */
+    size_t count;
+} vpdsi_ogrid_level;
+
+typedef struct vpdsi_ogrid {
+    int dim, levels;               /* levels in use: side >= the box extent / 2^BITS */
+    double lo[3];
+    vpdsi_ogrid_level lv[VPDSI_OGRID_LEVELS];
+    uint64_t *keys;                /* 0: empty slot; else 1 + (level, cell) */
+    int32_t *heads;                /* first sample of the slot's cell */
+    size_t cap, used;              /* slots (a power of two), slots in use */
+    int32_t *next;                 /* per sample: the next one of its cell, -1 at the end */
+    size_t cap_next;
+} vpdsi_ogrid;
+
+/* Lay out over the box [lo, hi] for radii up to about top; -1 when dim > 3 (nothing held). */
+int vpdsi_ogrid_setup(vpdsi_ogrid *g, int dim, const double *lo, const double *hi, double top);
+void vpdsi_ogrid_release(vpdsi_ogrid *g, vpdsi_mem *m);
+/* Room for `more` inserts, the grid then holding n_total samples; -1 on OOM (nothing lost). */
+int vpdsi_ogrid_reserve(vpdsi_ogrid *g, vpdsi_mem *m, size_t n_total, size_t more);
+/* File sample i (after a reserve). Never allocates. */
+void vpdsi_ogrid_insert(vpdsi_ogrid *g, const vpdsi_kd_samples *s, int32_t i);
+/* vpdsi_kd_conflict and vpdsi_kd_gather on the grid (open axes only): the same per-sample
+ * tests (proximity.h), so the same answers; other orders. */
+int32_t vpdsi_ogrid_conflict(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const double *y,
+                             double ry, int rule, double scale, double lipschitz,
+                             int32_t *witness);
+int vpdsi_ogrid_gather(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const double *lo,
+                       const double *hi, double r_hi, int rule, double scale, int split,
+                       vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap);
+#endif
