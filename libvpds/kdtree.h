@@ -7,13 +7,10 @@
 #ifndef VPDS_KDTREE_H
 #define VPDS_KDTREE_H
 #include "mem.h"
+#include "samples.h"
 
 #define VPDSI_KD_LEAF 8        /* samples per leaf before it splits */
 #define VPDSI_KD_MAX_DEPTH 480 /* deeper leaves stop splitting: slower, never wrong */
-
-/* Per-sample flags. */
-#define VPDSI_SAMPLE_FIXED 1u      /* added by vpds_add_points */
-#define VPDSI_SAMPLE_OWN_RADIUS 2u /* its radius was given, not read from the sizing */
 
 typedef struct vpdsi_kd_node {
     int32_t left, right;  /* left < 0: a leaf */
@@ -34,13 +31,6 @@ typedef struct vpdsi_kdtree {
     int32_t *next; /* per sample: next sample in the same leaf, -1 at the end */
     size_t cap_next;
 } vpdsi_kdtree;
-
-/* The samples the tree indexes (owned by the sampler, which may move them). */
-typedef struct vpdsi_kd_samples {
-    const double *x;   /* n * dim */
-    const double *r;   /* n */
-    const uint8_t *flags;
-} vpdsi_kd_samples;
 
 void vpdsi_kd_init(vpdsi_kdtree *t, int dim);
 /* Measure distances on a torus along the axes with period[k] > 0 (NULL: none). */

@@ -6,7 +6,8 @@
  * levels, so a query reads a few cells of each where the kd-tree walks from its root. */
 #ifndef VPDS_OGRID_H
 #define VPDS_OGRID_H
-#include "kdtree.h"
+#include "mem.h"
+#include "samples.h"
 
 #define VPDSI_OGRID_LEVELS 40
 #define VPDSI_OGRID_BITS 19 /* cell coordinate bits per axis (dim <= 3) */

@@ -3,8 +3,8 @@
  * test. Distances are on the torus of `period` (0 on an open axis, torus.h). */
 #ifndef VPDS_PROXIMITY_H
 #define VPDS_PROXIMITY_H
-#include "kdtree.h"
 #include "rules.h"
+#include "samples.h"
 #include "torus.h"
 
 /* Sample i against the dart y of radius ry: 1 when it conflicts (|y - x| < scale f), -2 when

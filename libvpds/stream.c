@@ -576,7 +576,7 @@ vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_m
      * would take another of them first), and no draw is spent. The step's pop and push come
      * after, in the order of a run that never failed. */
     for (;;) {
-        double key, next, centre[VPDS_MAX_DIM], half[VPDS_MAX_DIM], bound, y[VPDS_MAX_DIM], gy;
+        double key, next, centre[VPDS_MAX_DIM], half[VPDS_MAX_DIM], bound = 0, y[VPDS_MAX_DIM], gy;
         double t = 0, x[VPDS_MAX_DIM], rx = 0, step_lb;
         int split, event;
         size_t w = rec_words(sm);
