@@ -396,6 +396,16 @@ static void children_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned 
     }
 }
 
+/* Coordinates of child b of cell c (bit k of b: the upper half on axis k); without a split
+ * the "child" is the cell itself. */
+static void child_coords(int d, const uint64_t *c, unsigned b, int split, uint64_t *cc)
+{
+    int k;
+    for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
+}
+
+static int bit_set(const uint64_t *bits, unsigned b) { return (int)(bits[b >> 6] >> (b & 63u) & 1u); }
+
 /* A cell that straddles the domain's boundary (centre's sdf phi): mark as covered each kept
  * child that lies outside the domain, and, with one radius, each whose part inside the domain
  * is covered by the union of disks (a search inside it); else such children would split along
@@ -412,8 +422,8 @@ static vpds_status drop_outside_children(vpdsi_mps *m, const vpdsi_ctx *ctx, uns
     for (b = 0; b < children; b++) {
         double clo[VPDS_MAX_DIM], chi[VPDS_MAX_DIM], cm[VPDS_MAX_DIM], half, phi_c = phi;
         int found = 1;
-        if (covered[b >> 6] >> (b & 63u) & 1u) continue;
-        for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
+        if (bit_set(covered, b)) continue;
+        child_coords(d, c, b, split, cc);
         half = 0.5 * sqrt(vpdsi_lattice_box(&m->run.geom, split ? level + 1 : level, cc, clo, chi));
         for (k = 0; k < d; k++) cm[k] = 0.5 * (clo[k] + chi[k]);
         if (split) {
@@ -428,16 +438,6 @@ static vpds_status drop_outside_children(vpdsi_mps *m, const vpdsi_ctx *ctx, uns
     }
     return VPDS_OK;
 }
-
-/* Coordinates of child b of cell c (bit k of b: the upper half on axis k); without a split
- * the "child" is the cell itself. */
-static void child_coords(int d, const uint64_t *c, unsigned b, int split, uint64_t *cc)
-{
-    int k;
-    for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
-}
-
-static int bit_set(const uint64_t *bits, unsigned b) { return (int)(bits[b >> 6] >> (b & 63u) & 1u); }
 
 /* r at the centres of the n cells from run->pos: it bounds r over each cell through L. */
 static vpds_status centre_radii(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, unsigned level)

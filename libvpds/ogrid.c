@@ -230,13 +230,14 @@ static int32_t head_of(const vpdsi_ogrid *g, int l, const uint64_t *c)
 
 /* The cells of level l to read for the range [a, b]: the range itself, or, when it has more
  * cells than the table has slots (a reach far above the level's radii), the table's cells of
- * that level within it: at most as many reads as the table has slots. Returns the next cell's
+ * that level within it (scan_table, from range_cells): at most as many reads as the table has
+ * slots. Returns the next cell's
  * first sample through *head (-1 at a cell without samples), 0 past the last cell. *pos is the
  * iteration state, 0 at the start. */
 static int next_range_cell(const vpdsi_ogrid *g, int l, const uint64_t *a, const uint64_t *b,
-                           uint64_t *c, size_t *pos, int32_t *head)
+                           int scan_table, uint64_t *c, size_t *pos, int32_t *head)
 {
-    if (range_cells(g->dim, a, b) > (double)g->cap) {
+    if (scan_table) {
         while (*pos < g->cap) {
             size_t j = (*pos)++;
             if (slot_in_range(g, j, l, a, b, c)) {
@@ -264,11 +265,13 @@ int32_t vpdsi_ogrid_conflict(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, co
         uint64_t a[3], b[3], c[3];
         size_t pos = 0;
         int32_t i;
+        int scan;
         double reach;
         if (l < 0 || l >= g->levels || g->lv[l].count == 0) continue;
         reach = scale * vpdsi_rule_f((vpds_rule)rule, g->lv[l].rmax, ry);
         if (!cell_range(g, l, y, y, reach, a, b)) continue;
-        while (next_range_cell(g, l, a, b, c, &pos, &i)) {
+        scan = range_cells(g->dim, a, b) > (double)g->cap;
+        while (next_range_cell(g, l, a, b, scan, c, &pos, &i)) {
             if (i < 0 || cell_beyond(g, l, c, y, y, reach)) continue;
             for (; i >= 0; i = g->next[i]) {
                 int hit = vpdsi_prox_conflict(s, i, g->dim, open_axes, y, ry, rule, scale,
@@ -295,12 +298,14 @@ int vpdsi_ogrid_gather(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const do
         uint64_t a[3], b[3], c[3];
         size_t pos = 0;
         int32_t i;
+        int scan;
         double reach;
         if (g->lv[l].count == 0) continue;
         reach = scale * vpdsi_rule_f((vpds_rule)rule, g->lv[l].rmax, r_hi);
         /* a sample covers a sub-box only from within its reach of the box */
         if (!cell_range(g, l, lo, hi, reach, a, b)) continue;
-        while (next_range_cell(g, l, a, b, c, &pos, &i)) {
+        scan = range_cells(g->dim, a, b) > (double)g->cap;
+        while (next_range_cell(g, l, a, b, scan, c, &pos, &i)) {
             if (i < 0 || cell_beyond(g, l, c, lo, hi, reach)) continue;
             for (; i >= 0; i = g->next[i]) {
                 if (!vpdsi_prox_may_cover(s, i, g->dim, open_axes, c0, c1, w, r_hi, rule, scale))

@@ -158,6 +158,12 @@ static vpds_status build_regions(vpdsi_stream *sm, const vpdsi_ctx *ctx)
 
 /* ---- the search inside one region ---- */
 
+/* The stream's relative tolerance (vpds.h): looser with a domain. */
+static double stream_tolerance(const vpdsi_ctx *ctx)
+{
+    return ctx->dom->fn ? VPDS_STREAM_DOMAIN_TOLERANCE : VPDS_STREAM_TOLERANCE;
+}
+
 /* Exact g at each of n centres (and argmin), and an upper bound of g over the box of half
  * sides half around each: (|c - x*| + h) / f(r(x*), r(c) - L h), x* the argmin at c. */
 static vpds_status eval_boxes(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centres, size_t n, const double *half,
@@ -317,7 +323,7 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
     region_search q;
     long splits;
     vpds_status e;
-    q.tol = ctx->dom->fn ? VPDS_STREAM_DOMAIN_TOLERANCE : VPDS_STREAM_TOLERANCE;
+    q.tol = stream_tolerance(ctx);
     q.extra = -1;
     q.y = y;
     if ((e = eval_boxes(sm, ctx, centre, 1, half, &g1, &ub1)) != VPDS_OK) return e;
@@ -525,7 +531,7 @@ static vpds_status bound_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, double k
                                 double *bound, double *y, double *gy)
 {
     int v3 = ctx->pb->algorithm >= 3;
-    double tol = ctx->dom->fn ? VPDS_STREAM_DOMAIN_TOLERANCE : VPDS_STREAM_TOLERANCE;
+    double tol = stream_tolerance(ctx);
     /* version 3 stops a search below the next key, so a cached point is the region's
      * maximiser only when it is within the tolerance of the key */
     if (*gy >= 0 && (!v3 || *gy * (1 + tol) >= key)) {
@@ -561,13 +567,16 @@ vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_m
     int d = ctx->pb->dim;
     uint64_t rec[3 + 2 * VPDS_MAX_DIM];
     vpdsi_rng start = *ctx->rng;
-    /* version 3: the largest g seen since the last sample, a lower bound of max g; kept in
-     * the stream (committed after each step that succeeds), so that a call that fails and its
-     * retry take the steps of a call that never failed */
-    double lb = sm->lb_n == st->n ? sm->lb : -1;
     vpds_status e;
     if ((e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
     if ((e = vpdsi_store_reserve(st, 1)) != VPDS_OK) return e;
+    /* version 3: sm->lb, the largest g seen since the last sample, is a lower bound of max g;
+     * kept in the stream (committed after each step that succeeds), so that a call that fails
+     * and its retry take the steps of a call that never failed */
+    if (sm->lb_n != st->n) { /* a sample since: the bound no longer holds */
+        sm->lb = -1;
+        sm->lb_n = st->n;
+    }
     if (st->n == 0) return t_min >= INFINITY ? VPDS_STREAM_END : first_sample(ctx, x_out, t_out);
     if (!sm->active && (e = build_regions(sm, ctx)) != VPDS_OK) return e;
     /* The top region is read, not popped, until every callback of the step has answered: a
@@ -596,7 +605,7 @@ vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_m
         region_box(sm, (unsigned)rec[1], rec + REC_COORD, centre, half);
         if ((e = split_if_coarse(sm, ctx, rec, centre, half, t_cap, &split)) != VPDS_OK) return e;
         if (split) continue;
-        step_lb = lb;
+        step_lb = sm->lb;
         if ((e = bound_region(sm, ctx, key, next, &step_lb, centre, half, &bound, y, &gy)) != VPDS_OK)
             return e;
         /* an event at t = bound (an upper bound of max g), never above the scale at which the
@@ -611,9 +620,7 @@ vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_m
         }
         heap_pop(sm, rec);
         heap_push(sm, bound, (unsigned)rec[1], rec + REC_COORD, gy, y);
-        lb = step_lb;
-        sm->lb = lb;
-        sm->lb_n = st->n;
+        sm->lb = step_lb;
         if (!event) continue;
         if (t <= t_min) return VPDS_STREAM_END;
         vpdsi_store_append(st, x, rx, t, 0);
