@@ -347,8 +347,15 @@ static double near_limit(double r, double r_bound, double scale, double slack)
 static int is_near(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i, const double *lo,
                    const double *hi, double r_bound, double scale, double slack)
 {
-    double lim = near_limit(s->r[i], r_bound, scale, slack);
-    return vpdsi_box_mindist2(t, s->x + (size_t)i * (size_t)t->dim, lo, hi) <= lim * lim;
+    const double *x = s->x + (size_t)i * (size_t)t->dim;
+    double lim = near_limit(s->r[i], r_bound, scale, slack), lim2 = lim * lim, g2 = 0;
+    int k;
+    for (k = 0; k < t->dim; k++) {
+        double e = vpdsi_axis_gap(x[k], lo[k], hi[k], t->period[k]);
+        g2 += e * e;
+        if (g2 > lim2) return 0; /* the sum only grows */
+    }
+    return 1;
 }
 
 int vpdsi_kd_near_box(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *lo,
@@ -392,6 +399,19 @@ size_t vpdsi_kd_filter_near(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, co
     size_t j, count = 0;
     for (j = 0; j < n; j++)
         if (is_near(t, s, from[j], lo, hi, r_bound, scale, slack)) out[count++] = from[j];
+    return count;
+}
+
+size_t vpdsi_kd_list_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *from,
+                            size_t n, const double *lo, const double *hi, double r_hi, int rule,
+                            double scale, int split, int32_t *out)
+{
+    double c0[VPDS_MAX_DIM], c1[VPDS_MAX_DIM], w[VPDS_MAX_DIM];
+    size_t j, count = 0;
+    vpdsi_prox_gather_centres(t->dim, lo, hi, split, c0, c1, w);
+    for (j = 0; j < n; j++)
+        if (vpdsi_prox_may_cover(s, from[j], t->dim, t->period, c0, c1, w, r_hi, rule, scale))
+            out[count++] = from[j];
     return count;
 }
 

@@ -90,6 +90,11 @@ int vpdsi_kd_near_box(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const do
 size_t vpdsi_kd_filter_near(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *from,
                             size_t n, const double *lo, const double *hi, double r_bound,
                             double scale, double slack, int32_t *out);
+/* vpdsi_kd_gather over a list (from vpdsi_kd_near_box of an enclosing box, r_bound >= r_hi):
+ * the same samples, in the list's order. */
+size_t vpdsi_kd_list_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *from,
+                            size_t n, const double *lo, const double *hi, double r_hi, int rule,
+                            double scale, int split, int32_t *out);
 /* Whether a candidate conflicts with y (vpdsi_kd_conflict without the Lipschitz check). */
 int vpdsi_kd_list_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *cand,
                            size_t n, const double *y, double ry, int rule, double scale);

@@ -43,6 +43,10 @@ void vpdsi_mps_release(vpdsi_mps *m, vpdsi_store *st)
 {
     vpdsi_mps_release_cells(m, st);
     vpdsi_mem_free(st->mem, m->cand, m->cap_cand * sizeof(int32_t));
+    vpdsi_mem_free(st->mem, m->near, m->cap_near * sizeof(int32_t));
+    m->near = NULL;
+    m->n_near = m->cap_near = 0;
+    m->near_store_n = 0;
     vpdsi_mem_free(st->mem, m->buf_x, m->cap_buf_x * sizeof(double));
     vpdsi_mem_free(st->mem, m->buf_r, m->cap_buf_r * sizeof(double));
     vpdsi_mem_free(st->mem, m->buf_u, m->cap_buf_u * sizeof(double));
@@ -456,6 +460,46 @@ static vpds_status centre_radii(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, un
     return vpdsi_store_radii(ctx->st, m->buf_x, n, m->buf_r);
 }
 
+#ifndef NEAR_STRIP
+#define NEAR_STRIP 4
+#endif
+/* Into m->near, unless it holds them already: the samples that may cover part of some cell of
+ * the base cell holding c (the kd-tree path with one radius). */
+static int near_base_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t *c, unsigned level,
+                          double scale)
+{
+    const vpdsi_store *st = ctx->st;
+    const vpdsi_lattice *g = &m->run.geom;
+    vpdsi_kd_samples view = vpdsi_store_view(st);
+    uint64_t base[VPDS_MAX_DIM], idx = 0;
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
+    int k;
+    for (k = g->dim - 1; k >= 0; k--) {
+        base[k] = c[k] >> level;
+        idx = idx * g->n0[k] + (k == 0 ? base[k] / NEAR_STRIP : base[k]);
+    }
+    if (m->near_store_n == st->n && st->n > 0 && m->near_base == idx) return 0;
+    vpdsi_lattice_box(g, 0, base, lo, hi);
+    {
+        uint64_t first = base[0] - base[0] % NEAR_STRIP, last = first + NEAR_STRIP - 1;
+        double l2[VPDS_MAX_DIM], h2[VPDS_MAX_DIM];
+        if (last >= g->n0[0]) last = g->n0[0] - 1;
+        base[0] = first;
+        vpdsi_lattice_box(g, 0, base, lo, h2);
+        base[0] = last;
+        vpdsi_lattice_box(g, 0, base, l2, hi);
+    }
+    m->n_near = 0;
+    m->near_store_n = 0;
+    if (vpdsi_kd_near_box(&st->tree, &view, lo, hi, st->sizing.radius, scale, 0.0, SIZE_MAX,
+                          ctx->mem, &m->near, &m->n_near, &m->cap_near) < 0 ||
+        vpdsi_mem_reserve(ctx->mem, (void **)&m->cand, &m->cap_cand, m->n_near, sizeof(int32_t)))
+        return -1;
+    m->near_base = idx;
+    m->near_store_n = st->n;
+    return 0;
+}
+
 /* The samples that may cover part of cell c ([lo, hi], r <= r_hi over it) into m->cand. */
 static vpds_status gather_near(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t *c,
                                unsigned level, const double *lo, const double *hi, double r_hi,
@@ -470,12 +514,19 @@ static vpds_status gather_near(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_
         int k;
         for (k = 0; k < pb->dim; k++) base[k] = c[k] >> level; /* the base cell holding this one */
         m->n_cand = vpdsi_bgrid_near(&st->grid, vpdsi_bgrid_index(&st->grid, base), m->cand);
+    } else if (st->sizing.kind == VPDSI_SIZING_CONSTANT && !st->ogrid_mode) {
+        vpdsi_kd_samples view = vpdsi_store_view(st);
+        if (near_base_cell(m, ctx, c, level, scale)) goto oom;
+        m->n_cand = vpdsi_kd_list_gather(&st->tree, &view, m->near, m->n_near, lo, hi, r_hi,
+                                         (int)pb->rule, scale, split, m->cand);
     } else if (vpdsi_store_gather(st, lo, hi, r_hi, (int)pb->rule, scale, split, &m->cand,
                                   &m->n_cand, &m->cap_cand)) {
-        vpdsi_store_error(st, "out of memory gathering the samples near a cell");
-        return VPDS_ERR_OUT_OF_MEMORY;
+        goto oom;
     }
     return VPDS_OK;
+oom:
+    vpdsi_store_error(st, "out of memory gathering the samples near a cell");
+    return VPDS_ERR_OUT_OF_MEMORY;
 }
 
 /* Two radii: which kept children may hold an uncovered point: not inside one coverage disk
@@ -657,6 +708,7 @@ static void begin_sweep(vpdsi_mps *m, const vpdsi_ctx *ctx, int split)
 {
     vpdsi_cells_layout(&m->run.next, ctx->pb->dim, m->run.geom.n0, cur_level(m) + (split ? 1u : 0u));
     m->run.pos = 0;
+    m->near_store_n = 0; /* the samples changed, and with a new scale the base cells */
 }
 
 /* One chunk of the sweep (or the filter) of at most limit cells; *done: work units spent. */

@@ -37,6 +37,11 @@ typedef struct vpdsi_mps {
     double *buf_r; size_t cap_buf_r;        /* r there */
     double *buf_u; size_t cap_buf_u;        /* weighted mode: the acceptance draw of each dart */
     vpdsi_uncovered unc;                    /* two radii */
+    /* The samples near one base cell (the kd-tree path, one radius): the cells a base cell
+     * holds are swept one after another, so their gathers filter this list, searched once. */
+    int32_t *near; size_t n_near, cap_near;
+    uint64_t near_base;                     /* its base cell (linear index) */
+    size_t near_store_n;                    /* the store's count when searched; 0: none */
 } vpdsi_mps;
 
 /* What one call may spend and whom it tells. */

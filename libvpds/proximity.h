@@ -56,12 +56,13 @@ static inline int vpdsi_prox_may_cover(const vpdsi_kd_samples *s, int32_t i, int
                                        const double *w, double r_hi, int rule, double scale)
 {
     const double *x = s->x + (size_t)i * (size_t)dim;
-    double f = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_hi), need = 0;
+    double f = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_hi), f2 = f * f, need = 0;
     int k;
     for (k = 0; k < dim; k++) {
         double fb = vpdsi_prox_far_bound(x[k], x[k], c0[k], c1[k], w[k], period[k]);
         need += fb * fb;
+        if (need > f2) return 0; /* the sum only grows */
     }
-    return !(need > f * f);
+    return !(need > f2);
 }
 #endif
