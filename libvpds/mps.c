@@ -43,10 +43,10 @@ void vpdsi_mps_release(vpdsi_mps *m, vpdsi_store *st)
 {
     vpdsi_mps_release_cells(m, st);
     vpdsi_mem_free(st->mem, m->cand, m->cap_cand * sizeof(int32_t));
-    vpdsi_mem_free(st->mem, m->near, m->cap_near * sizeof(int32_t));
-    m->near = NULL;
-    m->n_near = m->cap_near = 0;
-    m->near_store_n = 0;
+    vpdsi_mem_free(st->mem, m->strip.idx, m->strip.cap * sizeof(int32_t));
+    vpdsi_mem_free(st->mem, m->base.idx, m->base.cap * sizeof(int32_t));
+    memset(&m->strip, 0, sizeof m->strip);
+    memset(&m->base, 0, sizeof m->base);
     vpdsi_mem_free(st->mem, m->buf_x, m->cap_buf_x * sizeof(double));
     vpdsi_mem_free(st->mem, m->buf_r, m->cap_buf_r * sizeof(double));
     vpdsi_mem_free(st->mem, m->buf_u, m->cap_buf_u * sizeof(double));
@@ -461,43 +461,60 @@ static vpds_status centre_radii(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, un
 }
 
 #ifndef NEAR_STRIP
-#define NEAR_STRIP 4
+#define NEAR_STRIP 4 /* base cells along axis 0 that share one search of the kd-tree */
 #endif
-/* Into m->near, unless it holds them already: the samples that may cover part of some cell of
- * the base cell holding c (the kd-tree path with one radius). */
-static int near_base_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t *c, unsigned level,
-                          double scale)
+/* Base cells b and b' share a key when they lie in one strip (near_strip) or are one cell
+ * (near_base); 0 means none. */
+static uint64_t near_key(const vpdsi_lattice *g, const uint64_t *base, uint64_t strip)
+{
+    uint64_t key = 0;
+    int k;
+    for (k = g->dim - 1; k >= 0; k--) key = key * g->n0[k] + (k == 0 ? base[k] / strip : base[k]);
+    return key + 1;
+}
+
+/* The samples near the base cell holding c (the kd-tree path with one radius), searched once
+ * while the cells of a strip of base cells are swept one after another: m->strip holds those
+ * near the strip; below level 0, m->base those of them near the base cell. Returns the list. */
+static const vpdsi_near_list *near_lists(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t *c,
+                                         unsigned level, double scale)
 {
     const vpdsi_store *st = ctx->st;
     const vpdsi_lattice *g = &m->run.geom;
     vpdsi_kd_samples view = vpdsi_store_view(st);
-    uint64_t base[VPDS_MAX_DIM], idx = 0;
-    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
+    uint64_t base[VPDS_MAX_DIM], key, last;
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], x[VPDS_MAX_DIM];
     int k;
-    for (k = g->dim - 1; k >= 0; k--) {
-        base[k] = c[k] >> level;
-        idx = idx * g->n0[k] + (k == 0 ? base[k] / NEAR_STRIP : base[k]);
-    }
-    if (m->near_store_n == st->n && st->n > 0 && m->near_base == idx) return 0;
-    vpdsi_lattice_box(g, 0, base, lo, hi);
-    {
-        uint64_t first = base[0] - base[0] % NEAR_STRIP, last = first + NEAR_STRIP - 1;
-        double l2[VPDS_MAX_DIM], h2[VPDS_MAX_DIM];
-        if (last >= g->n0[0]) last = g->n0[0] - 1;
+    for (k = 0; k < g->dim; k++) base[k] = c[k] >> level;
+    if (m->strip.store_n != st->n) m->strip.key = m->base.key = 0;
+    if ((key = near_key(g, base, NEAR_STRIP)) != m->strip.key) {
+        uint64_t first = base[0] - base[0] % NEAR_STRIP, b0 = base[0];
+        last = first + NEAR_STRIP - 1 < g->n0[0] ? first + NEAR_STRIP - 1 : g->n0[0] - 1;
         base[0] = first;
-        vpdsi_lattice_box(g, 0, base, lo, h2);
+        vpdsi_lattice_box(g, 0, base, lo, x);
         base[0] = last;
-        vpdsi_lattice_box(g, 0, base, l2, hi);
+        vpdsi_lattice_box(g, 0, base, x, hi);
+        base[0] = b0;
+        m->strip.n = 0;
+        if (vpdsi_kd_near_box(&st->tree, &view, lo, hi, st->sizing.radius, scale, 0.0, SIZE_MAX,
+                              ctx->mem, &m->strip.idx, &m->strip.n, &m->strip.cap) < 0 ||
+            vpdsi_mem_reserve(ctx->mem, (void **)&m->base.idx, &m->base.cap, m->strip.n,
+                              sizeof(int32_t)) ||
+            vpdsi_mem_reserve(ctx->mem, (void **)&m->cand, &m->cap_cand, m->strip.n,
+                              sizeof(int32_t)))
+            return NULL;
+        m->strip.key = key;
+        m->strip.store_n = st->n;
+        m->base.key = 0;
     }
-    m->n_near = 0;
-    m->near_store_n = 0;
-    if (vpdsi_kd_near_box(&st->tree, &view, lo, hi, st->sizing.radius, scale, 0.0, SIZE_MAX,
-                          ctx->mem, &m->near, &m->n_near, &m->cap_near) < 0 ||
-        vpdsi_mem_reserve(ctx->mem, (void **)&m->cand, &m->cap_cand, m->n_near, sizeof(int32_t)))
-        return -1;
-    m->near_base = idx;
-    m->near_store_n = st->n;
-    return 0;
+    if (level == 0) return &m->strip; /* each base cell is swept once at level 0 */
+    if ((key = near_key(g, base, 1)) != m->base.key) {
+        vpdsi_lattice_box(g, 0, base, lo, hi);
+        m->base.n = vpdsi_kd_filter_near(&st->tree, &view, m->strip.idx, m->strip.n, lo, hi,
+                                         st->sizing.radius, scale, 0.0, m->base.idx);
+        m->base.key = key;
+    }
+    return &m->base;
 }
 
 /* The samples that may cover part of cell c ([lo, hi], r <= r_hi over it) into m->cand. */
@@ -516,8 +533,9 @@ static vpds_status gather_near(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_
         m->n_cand = vpdsi_bgrid_near(&st->grid, vpdsi_bgrid_index(&st->grid, base), m->cand);
     } else if (st->sizing.kind == VPDSI_SIZING_CONSTANT && !st->ogrid_mode) {
         vpdsi_kd_samples view = vpdsi_store_view(st);
-        if (near_base_cell(m, ctx, c, level, scale)) goto oom;
-        m->n_cand = vpdsi_kd_list_gather(&st->tree, &view, m->near, m->n_near, lo, hi, r_hi,
+        const vpdsi_near_list *near = near_lists(m, ctx, c, level, scale);
+        if (!near) goto oom;
+        m->n_cand = vpdsi_kd_list_gather(&st->tree, &view, near->idx, near->n, lo, hi, r_hi,
                                          (int)pb->rule, scale, split, m->cand);
     } else if (vpdsi_store_gather(st, lo, hi, r_hi, (int)pb->rule, scale, split, &m->cand,
                                   &m->n_cand, &m->cap_cand)) {
@@ -708,7 +726,7 @@ static void begin_sweep(vpdsi_mps *m, const vpdsi_ctx *ctx, int split)
 {
     vpdsi_cells_layout(&m->run.next, ctx->pb->dim, m->run.geom.n0, cur_level(m) + (split ? 1u : 0u));
     m->run.pos = 0;
-    m->near_store_n = 0; /* the samples changed, and with a new scale the base cells */
+    m->strip.key = m->base.key = 0; /* new samples, and with a new scale new base cells */
 }
 
 /* One chunk of the sweep (or the filter) of at most limit cells; *done: work units spent. */

@@ -30,6 +30,13 @@ typedef struct vpdsi_run {
     int vsplit;                    /* VFILTER: bit 0 the sweep split, bit 1 it was FILTER */
 } vpdsi_run;
 
+/* Samples near a box of the lattice, kept while the cells in it are swept (mps.c). */
+typedef struct vpdsi_near_list {
+    int32_t *idx; size_t n, cap;
+    uint64_t key;                           /* which box; 0: none */
+    size_t store_n;                         /* the store's count when searched */
+} vpdsi_near_list;
+
 typedef struct vpdsi_mps {
     vpdsi_run run;
     int32_t *cand; size_t n_cand, cap_cand; /* the samples near the cell being swept */
@@ -37,11 +44,7 @@ typedef struct vpdsi_mps {
     double *buf_r; size_t cap_buf_r;        /* r there */
     double *buf_u; size_t cap_buf_u;        /* weighted mode: the acceptance draw of each dart */
     vpdsi_uncovered unc;                    /* two radii */
-    /* The samples near one base cell (the kd-tree path, one radius): the cells a base cell
-     * holds are swept one after another, so their gathers filter this list, searched once. */
-    int32_t *near; size_t n_near, cap_near;
-    uint64_t near_base;                     /* its base cell (linear index) */
-    size_t near_store_n;                    /* the store's count when searched; 0: none */
+    vpdsi_near_list strip, base;            /* the samples near the cells being swept */
 } vpdsi_mps;
 
 /* What one call may spend and whom it tells. */
