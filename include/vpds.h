@@ -47,7 +47,7 @@ extern "C" {
  * points for vpds_next after vpds_run). */
 #define VPDS_ALGORITHM_VERSION 3
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
-#define VPDS_MAX_DIM 8
+#define VPDS_MAX_DIM 16
 /* Relative tolerance eps of the continuous stream (vpds_next): each t it reports is an upper
  * bound of the scale at which the earlier samples stop being maximal, and the point inserted
  * there is within t * (1 - eps) * inhibition * f of them at worst (exact with two radii when
@@ -343,6 +343,8 @@ typedef struct vpds_tile_points {
 
 /* Most dependencies a tile can have: its 3^dim - 1 neighbours. */
 #define VPDS_TILING_MAX_DEPS 6560
+/* Largest dim of a tiling (a tile has up to 3^dim - 1 neighbours); larger is VPDS_ERR_UNSUPPORTED. */
+#define VPDS_TILING_MAX_DIM 8
 
 VPDS_API vpds_tiling_desc vpds_default_tiling_desc(void);
 /* Why a tiling is refused (field and value), into msg. Tiles thinner than the margin are

@@ -357,18 +357,27 @@ static int box_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, const double *l
     return vpdsi_kd_box_covered(&ctx->st->tree, &view, m->cand, m->n_cand, lo, hi, r_lo, (int)ctx->pb->rule, scale);
 }
 
-/* Which of the 2^d children of cell c are covered whole by one candidate. A child's farthest
- * point from x is, on each axis, the farther end of its half; so per candidate all children's
- * squared farthest distances are sums of 2 values per axis, built child by child from a
- * neighbour that differs in one axis. Bit b of covered is child b (bit k: upper half on axis k). */
+/* Children are decided BLOCK_CHILDREN at a time: all of them up to 8D, 2^(d-8) blocks past. */
+#define BLOCK_BITS 8
+#define BLOCK_CHILDREN (1u << BLOCK_BITS)
+static unsigned block_children(int d, int split)
+{
+    return !split ? 1u : d < BLOCK_BITS ? 1u << d : BLOCK_CHILDREN;
+}
+
+/* Which children of cell c in block `block` are covered whole by one candidate. A child's
+ * farthest point from x is, on each axis, the farther end of its half; so per candidate all
+ * children's squared farthest distances are sums of 2 values per axis, built child by child
+ * from a neighbour that differs in one axis. Bit j of covered is child (block << 8) + j (bit k
+ * of a child's number: upper half on axis k). */
 static void children_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned level, const uint64_t *c, double r_lo,
-                             double scale, uint64_t *covered)
+                             double scale, unsigned block, uint64_t *covered)
 {
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_store *st = ctx->st;
-    int d = pb->dim, k;
-    unsigned children = 1u << d, b;
-    double lo[VPDS_MAX_DIM], mid[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], sums[1u << VPDS_MAX_DIM];
+    int d = pb->dim, k, low = d < BLOCK_BITS ? d : BLOCK_BITS;
+    unsigned children = 1u << low, b;
+    double lo[VPDS_MAX_DIM], mid[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], sums[BLOCK_CHILDREN];
     uint64_t cc[VPDS_MAX_DIM] = {0};
     size_t j;
     for (k = 0; k < d; k++) cc[k] = 2 * c[k];
@@ -389,12 +398,12 @@ static void children_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned 
         }
         if (least > f2) continue; /* covers no child */
         sums[0] = 0;
-        for (k = 0; k < d; k++) sums[0] += far[k][0];
+        for (k = 0; k < d; k++) sums[0] += far[k][k < low ? 0 : (block >> (k - low)) & 1u];
         if (sums[0] <= f2) covered[0] |= 1u;
         for (b = 1; b < children; b++) {
-            unsigned low = 0;
-            while (!((b >> low) & 1u)) low++;
-            sums[b] = sums[b & (b - 1)] - far[low][0] + far[low][1];
+            unsigned bit = 0;
+            while (!((b >> bit) & 1u)) bit++;
+            sums[b] = sums[b & (b - 1)] - far[bit][0] + far[bit][1];
             if (sums[b] <= f2) covered[b >> 6] |= UINT64_C(1) << (b & 63u);
         }
     }
@@ -402,7 +411,7 @@ static void children_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned 
 
 /* Coordinates of child b of cell c (bit k of b: the upper half on axis k); without a split
  * the "child" is the cell itself. */
-static void child_coords(int d, const uint64_t *c, unsigned b, int split, uint64_t *cc)
+static void child_coords(int d, const uint64_t *c, uint64_t b, int split, uint64_t *cc)
 {
     int k;
     for (k = 0; k < d; k++) cc[k] = split ? 2 * c[k] + ((b >> k) & 1u) : c[k];
@@ -415,19 +424,19 @@ static int bit_set(const uint64_t *bits, unsigned b) { return (int)(bits[b >> 6]
  * is covered by the union of disks (a search inside it); else such children would split along
  * the boundary down to the precision limit. Without a split the "child" is the cell itself. */
 static vpds_status drop_outside_children(vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned level, const uint64_t *c,
-                                         int split, const double *centre, double phi,
-                                         uint64_t *covered)
+                                         int split, unsigned block, const double *centre,
+                                         double phi, uint64_t *covered)
 {
     const vpdsi_problem *pb = ctx->pb;
     int d = pb->dim, k;
-    unsigned children = split ? 1u << d : 1u, b;
+    unsigned children = block_children(d, split), b;
     uint64_t cc[VPDS_MAX_DIM];
     vpds_status e;
     for (b = 0; b < children; b++) {
         double clo[VPDS_MAX_DIM], chi[VPDS_MAX_DIM], cm[VPDS_MAX_DIM], half, phi_c = phi;
         int found = 1;
         if (bit_set(covered, b)) continue;
-        child_coords(d, c, b, split, cc);
+        child_coords(d, c, ((uint64_t)block << BLOCK_BITS) + b, split, cc);
         half = 0.5 * sqrt(vpdsi_lattice_box(&m->run.geom, split ? level + 1 : level, cc, clo, chi));
         for (k = 0; k < d; k++) cm[k] = 0.5 * (clo[k] + chi[k]);
         if (split) {
@@ -547,29 +556,28 @@ oom:
     return VPDS_ERR_OUT_OF_MEMORY;
 }
 
-/* Two radii: which kept children may hold an uncovered point: not inside one coverage disk
- * (the gather, at the larger coverage reach, found every candidate), and not shown covered by
- * a search inside them; decided before anything is kept. */
+/* Two radii: which kept children of the block may hold an uncovered point: not inside one
+ * coverage disk (the gather, at the larger coverage reach, found every candidate; whole_c: the
+ * cell is inside one), and not shown covered by a search inside them. */
 static vpds_status flag_uncovered(vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned level,
-                                  const uint64_t *c, int split, const double *lo,
-                                  const double *hi, double r_lo, const uint64_t *covered,
-                                  uint8_t *flag)
+                                  const uint64_t *c, int split, unsigned block, int whole_c,
+                                  double r_lo, const uint64_t *covered, uint8_t *flag)
 {
     int d = ctx->pb->dim;
-    unsigned children = split ? 1u << d : 1u, b;
+    unsigned children = block_children(d, split), b;
     uint64_t cov_c[4] = {0, 0, 0, 0}, cc[VPDS_MAX_DIM];
     double scale_c = m->run.t * ctx->pb->coverage;
     vpds_status e;
-    if (box_covered(m, ctx, lo, hi, r_lo, scale_c))
+    if (whole_c)
         cov_c[0] = cov_c[1] = cov_c[2] = cov_c[3] = ~UINT64_C(0);
     else if (split)
-        children_covered(m, ctx, level, c, r_lo, scale_c, cov_c);
+        children_covered(m, ctx, level, c, r_lo, scale_c, block, cov_c);
     for (b = 0; b < children; b++) {
         double clo[VPDS_MAX_DIM], chi[VPDS_MAX_DIM];
         int found = 0;
         flag[b] = 0;
         if (bit_set(covered, b) || bit_set(cov_c, b)) continue;
-        child_coords(d, c, b, split, cc);
+        child_coords(d, c, ((uint64_t)block << BLOCK_BITS) + b, split, cc);
         vpdsi_lattice_box(&m->run.geom, split ? level + 1 : level, cc, clo, chi);
         if ((e = vpdsi_uncovered_in(&m->unc, ctx, m->run.t, clo, chi, 0.0, &found)) != VPDS_OK)
             return e;
@@ -578,24 +586,54 @@ static vpds_status flag_uncovered(vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned l
     return VPDS_OK;
 }
 
+/* One block of a cell's children (or the cell itself): the uncovered ones into run->next. */
+static vpds_status sweep_block(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t *c, int split,
+                               unsigned block, double r_lo, const double *centre, double phi,
+                               double h, int whole_c)
+{
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_run *run = &m->run;
+    int d = pb->dim;
+    unsigned level = cur_level(m), children = block_children(d, split), b;
+    double scale = run->t * pb->inhibition;
+    uint64_t covered[4] = {0, 0, 0, 0}, cc[VPDS_MAX_DIM];
+    uint8_t flag[BLOCK_CHILDREN]; /* two radii: the child may hold an uncovered point */
+    vpds_status e;
+    if (split) children_covered(m, ctx, level, c, r_lo, scale, block, covered);
+    if (ctx->dom->fn && phi > -0.5 * h &&
+        (e = drop_outside_children(m, ctx, level, c, split, block, centre, phi, covered)) != VPDS_OK)
+        return e;
+    if (pb->two_radii &&
+        (e = flag_uncovered(m, ctx, level, c, split, block, whole_c, r_lo, covered, flag)) != VPDS_OK)
+        return e;
+    for (b = 0; b < children; b++) {
+        if (bit_set(covered, b)) continue;
+        if (pb->two_radii) m->unc.flag[run->next.count] = flag[b];
+        child_coords(d, c, ((uint64_t)block << BLOCK_BITS) + b, split, cc);
+        vpdsi_cells_push(&run->next, d, cc);
+    }
+    return VPDS_OK;
+}
+
 /* One cell of the sweep (coordinates c, r at its centre rc): its uncovered children (or the
- * cell itself) into run->next, unless the cell lies outside the domain or inside one disk. */
+ * cell itself) into run->next, unless the cell lies outside the domain or inside one disk.
+ * On an error the cell leaves nothing in run->next (its retry sweeps it whole). */
 static vpds_status sweep_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t *c, double rc,
                               int need_r, int split)
 {
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_store *st = ctx->st;
     vpdsi_run *run = &m->run;
-    int d = pb->dim, k;
-    unsigned level = cur_level(m), children = split ? 1u << d : 1u, b;
+    int d = pb->dim, k, whole_c = 0;
+    unsigned level = cur_level(m), blocks = split && d > BLOCK_BITS ? 1u << (d - BLOCK_BITS) : 1u;
+    unsigned block;
     /* a cell is dropped inside one inhibition disk (with one radius: one coverage disk) */
     double scale = run->t * pb->inhibition, L = st->sizing.lipschitz;
     double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], centre[VPDS_MAX_DIM], phi = -INFINITY;
     double h = sqrt(vpdsi_lattice_box(&run->geom, level, c, lo, hi));
     double r_lo = need_r ? rc - L * h / 2 : st->sizing.radius;
     double r_hi = need_r ? rc + L * h / 2 : st->sizing.radius;
-    uint64_t covered[4] = {0, 0, 0, 0}, cc[VPDS_MAX_DIM];
-    uint8_t flag[1u << VPDS_MAX_DIM]; /* two radii: the child may hold an uncovered point */
+    size_t kept = run->next.count;
     vpds_status e;
     if (ctx->dom->fn) {
         for (k = 0; k < d; k++) centre[k] = 0.5 * (lo[k] + hi[k]);
@@ -604,18 +642,12 @@ static vpds_status sweep_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t
     }
     if ((e = gather_near(m, ctx, c, level, lo, hi, r_hi, split)) != VPDS_OK) return e;
     if (box_covered(m, ctx, lo, hi, r_lo, scale)) return VPDS_OK;
-    if (split) children_covered(m, ctx, level, c, r_lo, scale, covered);
-    if (ctx->dom->fn && phi > -0.5 * h &&
-        (e = drop_outside_children(m, ctx, level, c, split, centre, phi, covered)) != VPDS_OK)
-        return e;
-    if (pb->two_radii &&
-        (e = flag_uncovered(m, ctx, level, c, split, lo, hi, r_lo, covered, flag)) != VPDS_OK)
-        return e;
-    for (b = 0; b < children; b++) {
-        if (bit_set(covered, b)) continue;
-        if (pb->two_radii) m->unc.flag[run->next.count] = flag[b];
-        child_coords(d, c, b, split, cc);
-        vpdsi_cells_push(&run->next, d, cc);
+    if (pb->two_radii) whole_c = box_covered(m, ctx, lo, hi, r_lo, run->t * pb->coverage);
+    for (block = 0; block < blocks; block++) {
+        if ((e = sweep_block(m, ctx, c, split, block, r_lo, centre, phi, h, whole_c)) != VPDS_OK) {
+            run->next.count = kept;
+            return e;
+        }
     }
     return VPDS_OK;
 }
@@ -626,7 +658,7 @@ static vpds_status sweep_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, int
 {
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_run *run = &m->run;
-    unsigned children = split ? 1u << pb->dim : 1u;
+    unsigned children = split ? 1u << pb->dim : 1u; /* n <= CHUNK >> (d - 8): no overflow */
     int varying = ctx->st->sizing.kind != VPDSI_SIZING_CONSTANT;
     /* r over the cell: for a rule that reads r(y), and for the reach of two radii' V */
     int need_r = varying && (vpdsi_rule_uses_y(pb->rule) || pb->two_radii);
@@ -736,6 +768,8 @@ static vpds_status sweep_step(vpdsi_mps *m, const vpdsi_ctx *ctx, uint64_t limit
     int split = run->phase == VPDSI_SWEEP && cur_level(m) < run->max_level;
     uint64_t total = cur_count(m), before = run->pos;
     vpds_status e;
+    /* past 8D a cell's 2^d children take the room of 2^(d-8) cells in a chunk */
+    if (split && ctx->pb->dim > BLOCK_BITS) limit = (limit >> (ctx->pb->dim - BLOCK_BITS)) + 1;
     if (total - run->pos < limit) limit = total - run->pos;
     e = sweep_chunk(m, ctx, (size_t)limit, split);
     *done = run->pos - before;

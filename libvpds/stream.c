@@ -31,6 +31,8 @@ void vpdsi_stream_release(vpdsi_stream *sm, vpdsi_mem *m)
     vpdsi_mem_free(m, sm->heap, sm->cap * sizeof(uint64_t));
     vpdsi_mem_free(m, sm->boxes, sm->cap_boxes * sizeof(double));
     vpdsi_mem_free(m, sm->buf, sm->cap_buf * sizeof(double));
+    vpdsi_mem_free(m, sm->kids, sm->cap_kids * sizeof(double));
+    vpdsi_mem_free(m, sm->kid_cells, sm->cap_kid_cells * sizeof(uint64_t));
     vpdsi_stream_init(sm);
 }
 
@@ -158,6 +160,16 @@ static vpds_status build_regions(vpdsi_stream *sm, const vpdsi_ctx *ctx)
 
 /* ---- the search inside one region ---- */
 
+/* Room for the 2^d children of one split (split_box, split_if_coarse). */
+static int reserve_kids(vpdsi_stream *sm, vpdsi_mem *m)
+{
+    size_t d = (size_t)sm->geom.dim, children = (size_t)1 << d;
+    return vpdsi_mem_reserve(m, (void **)&sm->kids, &sm->cap_kids, children * (d + 2),
+                             sizeof(double)) ||
+           vpdsi_mem_reserve(m, (void **)&sm->kid_cells, &sm->cap_kid_cells, children * d,
+                             sizeof(uint64_t));
+}
+
 /* The stream's relative tolerance (vpds.h): looser with a domain. */
 static double stream_tolerance(const vpdsi_ctx *ctx)
 {
@@ -238,7 +250,7 @@ static vpds_status split_box(vpdsi_stream *sm, const vpdsi_ctx *ctx, region_sear
 {
     int d = sm->geom.dim, k;
     size_t w = 1 + 2 * (size_t)d, children = (size_t)1 << d, j;
-    double cs[(1u << VPDS_MAX_DIM) * VPDS_MAX_DIM], gs[1u << VPDS_MAX_DIM], ubs[1u << VPDS_MAX_DIM];
+    double *cs = sm->kids, *gs = cs + children * (size_t)d, *ubs = gs + children;
     vpds_status e;
     for (j = 0; j < children; j++)
         for (k = 0; k < d; k++)
@@ -487,10 +499,10 @@ static vpds_status split_if_coarse(vpdsi_stream *sm, const vpdsi_ctx *ctx, uint6
 {
     int d = sm->geom.dim, k, v3 = ctx->pb->algorithm >= 3;
     double key = rec_key(rec), h = 0, r, L = ctx->st->sizing.lipschitz, scale = key;
-    double cs[(1u << VPDS_MAX_DIM) * VPDS_MAX_DIM], hs[VPDS_MAX_DIM];
-    double gs[1u << VPDS_MAX_DIM], ubs[1u << VPDS_MAX_DIM];
+    size_t children = (size_t)1 << d;
+    double *cs = sm->kids, *gs = cs + children * (size_t)d, *ubs = gs + children, hs[VPDS_MAX_DIM];
     unsigned level = (unsigned)rec[1];
-    uint64_t b, n = 0, cc[(1u << VPDS_MAX_DIM) * VPDS_MAX_DIM], cr[VPDS_MAX_DIM];
+    uint64_t b, n = 0, *cc = sm->kid_cells, cr[VPDS_MAX_DIM];
     vpds_status e;
     *split = 0;
     if (v3 && scale > t_cap) scale = t_cap;
@@ -591,7 +603,7 @@ vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_m
         size_t w = rec_words(sm);
         key = rec_key(sm->heap);
         if (key <= t_min) return VPDS_STREAM_END; /* every region is below: nothing consumed */
-        if (heap_reserve(sm, ctx->mem, (size_t)1 << d)) {
+        if (heap_reserve(sm, ctx->mem, (size_t)1 << d) || reserve_kids(sm, ctx->mem)) {
             vpdsi_store_error(st, "out of memory for the stream's regions");
             return VPDS_ERR_OUT_OF_MEMORY;
         }

@@ -16,6 +16,8 @@ typedef struct vpdsi_stream {
     double *boxes;                 /* the search inside one region: key, centre, half sides */
     size_t n_boxes, cap_boxes;
     double *buf;                   /* centres and radii of one split */
+    double *kids; size_t cap_kids; /* one split's 2^d children: centres, g, bounds */
+    uint64_t *kid_cells; size_t cap_kid_cells; /* and their cells */
     double lb;                     /* version 3: the largest g seen while the store held lb_n */
     size_t lb_n;                   /* samples (lb is -1 once a sample is added) */
     size_t cap_buf;

@@ -83,6 +83,10 @@ vpds_status vpds_tiling_validate(const vpds_tiling_desc *d, char *msg, size_t ca
     if (!d->sampler) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.sampler is NULL");
     if ((st = vpds_validate(d->sampler, inner, sizeof inner)) != VPDS_OK)
         VPDSI_REFUSE(st, "tiling desc.sampler: %s", inner);
+    if (d->sampler->dim > VPDS_TILING_MAX_DIM)
+        VPDSI_REFUSE(VPDS_ERR_UNSUPPORTED, "tiling desc.sampler->dim = %d: tilings go up to %d dimensions "
+              "(a tile has up to 3^dim - 1 neighbours); sample the box in one run", d->sampler->dim,
+              VPDS_TILING_MAX_DIM);
     if (!d->tiles) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.tiles is NULL (dim tile counts)");
     if (!isfinite(d->scale) || !(d->scale > 0))
         VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "tiling desc.scale = %g: must be finite and > 0", d->scale);

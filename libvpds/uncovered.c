@@ -325,38 +325,50 @@ static void first_box(bb_search *q, double *bx)
 }
 
 /* Depth first over the boxes from the first one: *found at the first "uncovered" verdict, or
- * when the boxes exceed the budget. */
+ * when the boxes exceed the budget. A frame of the stack is a box (lo, hi, depth) and how many
+ * of its 2^d children are still to visit (-1: the box itself is not examined yet); children
+ * are made one at a time, the last first, so the stack holds one frame per depth. */
 static vpds_status search(bb_search *q, int *found)
 {
     int d = q->pb->dim, k;
-    unsigned children = 1u << d, b;
-    size_t top = 1, boxes = 0, stride = 2 * (size_t)d + 1;
+    size_t top = 1, boxes = 0, stride = 2 * (size_t)d + 2;
     double *stack = q->u->stack;
     vpds_status st;
+    stack[2 * d + 1] = -1;
     while (top > 0) {
-        double *bx = stack + --top * stride, lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
+        double *bx = stack + (top - 1) * stride, *cb, left;
         int depth = (int)bx[2 * d], verdict;
-        memcpy(lo, bx, (size_t)d * sizeof(double));
-        memcpy(hi, bx + d, (size_t)d * sizeof(double));
-        if (++boxes > UNCOVERED_BUDGET) {
-            *found = 1;
-            return VPDS_OK;
-        }
-        if ((st = examine(q, lo, hi, depth, &verdict)) != VPDS_OK) return st;
-        if (verdict == 1) {
-            *found = 1;
-            return VPDS_OK;
-        }
-        if (verdict == 0) continue;
-        for (b = 0; b < children; b++) {
-            double *cb = stack + top++ * stride;
-            for (k = 0; k < d; k++) {
-                double mid = 0.5 * (lo[k] + hi[k]);
-                cb[k] = (b >> k) & 1u ? mid : lo[k];
-                cb[d + k] = (b >> k) & 1u ? hi[k] : mid;
+        unsigned b;
+        if (bx[2 * d + 1] < 0) {
+            double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
+            memcpy(lo, bx, (size_t)d * sizeof(double));
+            memcpy(hi, bx + d, (size_t)d * sizeof(double));
+            if (++boxes > UNCOVERED_BUDGET) {
+                *found = 1;
+                return VPDS_OK;
             }
-            cb[2 * d] = depth + 1;
+            if ((st = examine(q, lo, hi, depth, &verdict)) != VPDS_OK) return st;
+            if (verdict == 1) {
+                *found = 1;
+                return VPDS_OK;
+            }
+            bx[2 * d + 1] = verdict == 0 ? 0 : (double)(1u << d);
         }
+        left = bx[2 * d + 1];
+        if (left == 0) {
+            top--;
+            continue;
+        }
+        b = (unsigned)left - 1;
+        bx[2 * d + 1] = b;
+        cb = stack + top++ * stride;
+        for (k = 0; k < d; k++) {
+            double mid = 0.5 * (bx[k] + bx[d + k]);
+            cb[k] = (b >> k) & 1u ? mid : bx[k];
+            cb[d + k] = (b >> k) & 1u ? bx[d + k] : mid;
+        }
+        cb[2 * d] = depth + 1;
+        cb[2 * d + 1] = -1;
     }
     return VPDS_OK;
 }
@@ -367,7 +379,7 @@ vpds_status vpdsi_uncovered_in(vpdsi_uncovered *u, const vpdsi_ctx *ctx, double 
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_store *st = ctx->st;
     int d = pb->dim;
-    size_t stride = 2 * (size_t)d + 1, need;
+    size_t stride = 2 * (size_t)d + 2, need;
     bb_search q;
     vpds_status e;
     *found = 0;
@@ -388,7 +400,7 @@ vpds_status vpdsi_uncovered_in(vpdsi_uncovered *u, const vpdsi_ctx *ctx, double 
         *found = 1;
         return VPDS_OK;
     }
-    if (vpdsi_mul_size((size_t)UNCOVERED_DEPTH * (1u << d) + 1, stride, &need) ||
+    if (vpdsi_mul_size((size_t)UNCOVERED_DEPTH + 2, stride, &need) ||
         vpdsi_mem_reserve(st->mem, (void **)&u->stack, &u->cap_stack, need, sizeof(double))) {
         vpdsi_store_error(st, "out of memory for the two-radii coverage search");
         return VPDS_ERR_OUT_OF_MEMORY;

@@ -55,7 +55,7 @@ int main(void)
 
     /* dimension and box */
     d = vpds_default_desc(); d.dim = 0; refused(&d, "desc.dim = 0", VPDS_ERR_INVALID_ARGUMENT);
-    d.dim = VPDS_MAX_DIM + 1; refused(&d, "desc.dim = 9", VPDS_ERR_INVALID_ARGUMENT);
+    d.dim = VPDS_MAX_DIM + 1; refused(&d, "desc.dim = 17: must be in 1..16", VPDS_ERR_INVALID_ARGUMENT);
     d = vpds_default_desc(); bad[0] = 0; bad[1] = 1; d.lo = bad; d.hi = hi;
     bad[1] = 1; refused(&d, "desc.lo[1] = 1 >= desc.hi[1] = 1", VPDS_ERR_INVALID_ARGUMENT);
     bad[1] = NAN; refused(&d, "desc.lo[1] = nan", VPDS_ERR_INVALID_ARGUMENT);

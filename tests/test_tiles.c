@@ -417,6 +417,14 @@ static void check_errors(void)
     bad.radius = -1;
     t2 = td; t2.sampler = &bad;
     EXPECT_REFUSED(t2, VPDS_ERR_INVALID_ARGUMENT, "desc.sampler: desc.radius = -1");
+    {
+        vpds_desc high = vpds_default_desc();
+        uint64_t nine[9] = {2, 2, 2, 2, 2, 2, 2, 2, 2};
+        high.dim = 9;
+        high.radius = 1.5;
+        t2 = td; t2.sampler = &high; t2.tiles = nine;
+        EXPECT_REFUSED(t2, VPDS_ERR_UNSUPPORTED, "sampler->dim = 9: tilings go up to 8 dimensions");
+    }
     t2 = td; t2.tiles = NULL;
     EXPECT_REFUSED(t2, VPDS_ERR_INVALID_ARGUMENT, "tiles is NULL");
     t2 = td; t2.tiles = zero;

@@ -4,7 +4,7 @@
     >>> engine = vpds.PoissonDisk(2, radius=0.05, rng=1)
     >>> x = engine.fill_space()          # maximal, shape (n, 2)
 """
-from ._core import ALGORITHM_VERSION, RULES, PoissonDisk, Progressive, SizingGrid
+from ._core import ALGORITHM_VERSION, MAX_DIM, RULES, PoissonDisk, Progressive, SizingGrid
 from ._errors import (VpdsDomainError, VpdsError, VpdsSizingError, VpdsStateError, VpdsUnsupportedError,
                       VpdsValueError)
 from .domain import Domain, estimate_radius
@@ -17,4 +17,4 @@ STREAM_TOLERANCE: float = float(_lib.VPDS_STREAM_TOLERANCE)
 STREAM_DOMAIN_TOLERANCE: float = float(_lib.VPDS_STREAM_DOMAIN_TOLERANCE)
 __all__ = ["PoissonDisk", "SizingGrid", "VpdsError", "VpdsValueError", "VpdsSizingError",
            "VpdsUnsupportedError", "VpdsStateError", "RULES", "STREAM_TOLERANCE", "STREAM_DOMAIN_TOLERANCE", "VpdsDomainError", "Domain",
-           "Progressive", "estimate_radius", "ALGORITHM_VERSION", "__version__"]
+           "Progressive", "estimate_radius", "ALGORITHM_VERSION", "MAX_DIM", "__version__"]

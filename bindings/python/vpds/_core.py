@@ -17,10 +17,12 @@ from .sizing_grid import SizingGrid
 from ._typing import RngLike, SizingFunction
 
 __all__ = ["PoissonDisk", "SizingGrid", "VpdsError", "VpdsSizingError", "VpdsDomainError",
-           "Progressive", "RULES", "ALGORITHM_VERSION"]
+           "Progressive", "RULES", "ALGORITHM_VERSION", "MAX_DIM"]
 
 #: the algorithm version of this library: the points a seed gives (`algorithm_version` pins one)
 ALGORITHM_VERSION: int = int(lib.VPDS_ALGORITHM_VERSION)
+#: the largest dimension the library samples (VPDS_MAX_DIM)
+MAX_DIM: int = int(lib.VPDS_MAX_DIM)
 RULES = {"prior": lib.VPDS_RULE_PRIOR, "current": lib.VPDS_RULE_CURRENT,
          "bigger": lib.VPDS_RULE_BIGGER, "smaller": lib.VPDS_RULE_SMALLER}
 # work units (darts + cells) per C call in a fill: small enough for a responsive Ctrl-C and
@@ -57,7 +59,7 @@ class Progressive(NamedTuple):
 
 
 class PoissonDisk:
-    """Maximal Poisson-disk sampling with spatially varying radii, in any dimension (1 to 8).
+    """Maximal Poisson-disk sampling with spatially varying radii, in any dimension (1 to MAX_DIM = 16).
 
     A drop-in for ``scipy.stats.qmc.PoissonDisk`` (scipy's own TestPoisson passes against it:
     tests/py/test_scipy_suite.py): `d`, `radius`, `rng` (or `seed`, not both), `l_bounds`,

@@ -15,7 +15,7 @@ from typing import Any, Optional, Sequence
 import numpy as np
 import numpy.typing as npt
 
-from ._core import RULES, PoissonDisk, VpdsError
+from ._core import MAX_DIM, RULES, PoissonDisk, VpdsError
 from ._optional import MissingDependencyError, require
 from ._typing import SizingFunction
 from .cli_common import UsageError, domain_from_file, floats_arg, periodic_arg, sizing_from_expression
@@ -97,8 +97,8 @@ def _sample(args: argparse.Namespace, engine: PoissonDisk, expected: float) -> N
 
 def cmd_sample(args: argparse.Namespace) -> int:
     dim = args.dim
-    if not 1 <= dim <= 8:
-        raise UsageError(f"--dim {dim}: must be in 1..8")
+    if not 1 <= dim <= MAX_DIM:
+        raise UsageError(f"--dim {dim}: must be in 1..{MAX_DIM}")
     lo = floats_arg(args.lo, dim, 0.0, "--lo")
     hi = floats_arg(args.hi, dim, 1.0, "--hi")
     bad = [k for k in range(dim) if not lo[k] < hi[k]]

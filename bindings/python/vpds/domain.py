@@ -35,19 +35,24 @@ JAMMING_DENSITY = {1: 0.7476, 2: 0.5470, 3: 0.3841, 4: 0.2600, 5: 0.1707, 6: 0.1
                    7: 0.0683, 8: 0.0424}
 
 
+def jamming_density(d: int) -> float:
+    """JAMMING_DENSITY[d], past 8D extrapolated by the ratio of 8D to 7D (about 0.6 per axis)."""
+    return JAMMING_DENSITY[d] if d in JAMMING_DENSITY else JAMMING_DENSITY[8] * 0.6 ** (d - 8)
+
+
 def estimate_radius(n: int, d: int, volume: float = 1.0) -> float:
     """The radius r at which a maximal uniform sampling of a domain of this volume holds about
     n points: n * volume_of_ball(r / 2) = JAMMING_DENSITY[d] * volume. An estimate: boundaries
     add points (more so for small n and thin domains), and two radii or a sizing change it."""
-    if d not in JAMMING_DENSITY:
-        raise ValueError(f"d = {d}: must be in 1..8")
+    if not 1 <= d <= int(lib.VPDS_MAX_DIM):
+        raise ValueError(f"d = {d}: must be in 1..{lib.VPDS_MAX_DIM}")
     if not n >= 1:
         raise ValueError(f"n = {n}: must be >= 1")
     if not volume > 0 or not math.isfinite(volume):
         raise ValueError(f"volume = {volume}: must be finite and > 0")
     unit_ball = math.pi ** (d / 2) / math.gamma(d / 2 + 1)
     # annotated: float ** float is Any to mypy (a negative base would give a complex)
-    r: float = 2.0 * (JAMMING_DENSITY[d] * volume / (n * unit_ball)) ** (1.0 / d)
+    r: float = 2.0 * (jamming_density(d) * volume / (n * unit_ball)) ** (1.0 / d)
     return r
 
 

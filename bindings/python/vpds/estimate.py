@@ -15,7 +15,7 @@ from typing import Optional
 import numpy as np
 
 from ._typing import BoundsLike, DomainFunction, SizingFunction
-from .domain import JAMMING_DENSITY
+from .domain import jamming_density
 
 __all__ = ["Estimate", "estimate_run", "available_memory"]
 
@@ -43,7 +43,7 @@ def estimate_run(d: int, lo: BoundsLike, hi: BoundsLike, *, radius: float = 0.05
     lo_a, hi_a = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
     volume = float(np.prod(hi_a - lo_a))
     unit_ball = math.pi ** (d / 2) / math.gamma(d / 2 + 1)
-    density = JAMMING_DENSITY.get(d, JAMMING_DENSITY[8] * 0.6 ** (d - 8))
+    density = jamming_density(d)
     y = lo_a + (hi_a - lo_a) * np.random.default_rng(0).random((_PROBES, d))
     r = np.full(_PROBES, float(radius)) if sizing is None else np.asarray(sizing(y), dtype=np.float64)
     r = np.where(np.isfinite(r) & (r > 0), r, np.nan)

@@ -18,8 +18,8 @@ class SizingGrid:
 
     def __init__(self, values: npt.ArrayLike, lo: BoundsLike, hi: BoundsLike) -> None:
         v = np.ascontiguousarray(values, dtype=np.float64)
-        if v.ndim < 1 or v.ndim > 8:
-            raise ValueError(f"grid values have {v.ndim} dimensions; expected 1 to 8")
+        if v.ndim < 1 or v.ndim > int(lib.VPDS_MAX_DIM):
+            raise ValueError(f"grid values have {v.ndim} dimensions; expected 1 to {lib.VPDS_MAX_DIM}")
         self._values = v
         self._shape = ffi.new("size_t[]", list(v.shape))
         self._lo = ffi.new("double[]", [float(a) for a in lo])
