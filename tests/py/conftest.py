@@ -13,15 +13,17 @@ TOOL = Path(os.environ.get("VPDS_SAMPLE_TOOL", ROOT / "build" / "tests" / "sampl
 
 @pytest.fixture(scope="session")
 def sample(tmp_path_factory):
-    """sample(dim, rule, sizing, radius, seed, lo, hi) -> (x, r, t) from the C library."""
+    """sample(dim, rule, sizing, radius, seed, lo, hi, ..., extra=()) -> (x, r, t) from the C library."""
     from vpds import analysis as checker
 
     out_dir = tmp_path_factory.mktemp("samples")
 
-    def run(dim, rule, sizing, radius, seed, lo, hi, budget=0, weighted=0):
-        path = out_dir / f"{dim}-{rule}-{sizing}-{radius}-{seed}-{lo}-{hi}-{budget}-{weighted}.bin"
+    def run(dim, rule, sizing, radius, seed, lo, hi, budget=0, weighted=0, extra=()):
+        """extra: sample_tool's KEY=VALUE options (periodic=, inhibition=, hi0=, stream=, ...)"""
+        tag = "-".join(extra).replace("=", "")
+        path = out_dir / f"{dim}-{rule}-{sizing}-{radius}-{seed}-{lo}-{hi}-{budget}-{weighted}-{tag}.bin"
         cmd = [str(TOOL), str(path), str(dim), rule, sizing, repr(radius), str(seed), repr(lo),
-               repr(hi), str(budget), str(weighted)]
+               repr(hi), str(budget), str(weighted), *extra]
         subprocess.run(cmd, check=True, capture_output=True, text=True)
         return checker.load(str(path))
 

@@ -2,11 +2,13 @@
  * int64 n, int64 dim, then n*dim doubles x, n radii, n scales t.
  * usage: sample_tool OUT dim rule sizing radius seed lo hi [budget [weighted]] [KEY=VALUE...]
  *   rule: prior|current|bigger|smaller; sizing: const|ramp|radial (the paper's Figures 1, 10),
- *   mild (0.04 + 0.04 x) or steep (0.05 + 0.2 x, the fuzzers' ramp); weighted: 1 for the
+ *   mild (0.04 + 0.04 x), steep (0.05 + 0.2 x, the fuzzers' ramp) or wide (1.2 + 0.4 x, for 9D
+ *   and up); weighted: 1 for the
  *   weighted-bias-free process (Eq. 12)
  *   KEY=VALUE: inhibition=F (two radii), periodic=MASK (bit k: axis k), domain=ball (the ball
  *   of radius 0.4 about the box centre), version=N (desc.algorithm_version), run=0 (no
- *   vpds_run: a stream from empty), stream=N (then N events of vpds_next, t_min 0) */
+ *   vpds_run: a stream from empty), stream=N (then N events of vpds_next, t_min 0),
+ *   hi0=F (axis 0 ends at F: a longer box, for a few samples in high dimension) */
 #include "vpds.h"
 #include <math.h>
 #include <stdio.h>
@@ -15,6 +17,7 @@
 
 static double ramp(const double *x, void *u) { (void)u; return 0.001 + 0.3 * x[0]; }
 static double mild(const double *x, void *u) { (void)u; return 0.04 + 0.04 * x[0]; }
+static double wide(const double *x, void *u) { (void)u; return 1.2 + 0.4 * x[0]; }
 static double steep(const double *x, void *u) { (void)u; return 0.05 + 0.2 * fabs(x[0]); }
 static double ball(const double *x, void *u)
 {
@@ -68,6 +71,10 @@ int main(int argc, char **argv)
         d.sizing = mild;
         d.lipschitz = 0.04;
         d.radius_min = 0.04;
+    } else if (!strcmp(argv[4], "wide")) {
+        d.sizing = wide;
+        d.lipschitz = 0.4;
+        d.radius_min = 1.2;
     } else if (!strcmp(argv[4], "steep")) {
         d.sizing = steep;
         d.lipschitz = 0.2;
@@ -89,6 +96,8 @@ int main(int argc, char **argv)
         } else if (!strcmp(argv[a], "domain=ball")) {
             d.domain = ball;
             d.domain_user = &dim;
+        } else if (!strncmp(argv[a], "hi0=", 4)) {
+            hi[0] = atof(v); /* a longer first axis: a few samples in high dimension */
         } else if (!strncmp(argv[a], "run=", 4)) {
             run = atoi(v);
         } else if (!strncmp(argv[a], "stream=", 7)) {

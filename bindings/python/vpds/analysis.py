@@ -60,6 +60,8 @@ def sizing_named(name: str, radius: float = 0.0) -> Sizing:
         return Sizing(lambda y: 0.001 + 0.3 * y[:, 0], 0.3)
     if name == "mild":  # a gentle ramp, for the weighted process
         return Sizing(lambda y: 0.04 + 0.04 * y[:, 0], 0.04)
+    if name == "wide":  # radii for 9D and up, where a unit box holds a few samples
+        return Sizing(lambda y: 1.2 + 0.4 * y[:, 0], 0.4)
     if name == "radial":  # the paper's Figure 10
         def radial(y: FloatArray) -> FloatArray:
             d = np.sqrt(((y - 0.5) ** 2).sum(axis=1))
