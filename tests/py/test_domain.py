@@ -201,8 +201,9 @@ def test_estimate_radius():
         r = vpds.estimate_radius(2000, d)
         n = len(vpds.PoissonDisk(d, radius=r, rng=1, progress=False).fill_space())
         assert 0.85 * 2000 < n < 1.25 * 2000, (d, r, n)
-    with pytest.raises(ValueError, match="d = 9"):
-        vpds.estimate_radius(10, 9)
+    with pytest.raises(ValueError, match="d = 17: must be in 1..16"):
+        vpds.estimate_radius(10, 17)
+    assert 0 < vpds.estimate_radius(10, 12) < vpds.estimate_radius(5, 12)
 
 
 def test_bad_domains():

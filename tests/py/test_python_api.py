@@ -107,8 +107,8 @@ def test_errors_carry_the_c_message():
         vpds.PoissonDisk(2, inhibition=2.0, coverage=1.0)
     with pytest.raises(ValueError, match="rule"):
         vpds.PoissonDisk(2, rule="largest")
-    with pytest.raises(vpds.VpdsValueError, match="desc.dim = 9"):
-        vpds.PoissonDisk(9)
+    with pytest.raises(vpds.VpdsValueError, match="desc.dim = 17: must be in 1..16"):
+        vpds.PoissonDisk(vpds.MAX_DIM + 1)
     engine = vpds.PoissonDisk(2, sizing=lambda p: np.where(p[:, 0] > 0.5, np.nan, 0.05),
                               lipschitz=0.1, rng=1, progress=False)
     with pytest.raises(vpds.VpdsSizingError, match="r = nan at x = \\("):
