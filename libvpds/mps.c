@@ -365,6 +365,12 @@ static unsigned block_children(int d, int split)
     return !split ? 1u : d < BLOCK_BITS ? 1u << d : BLOCK_CHILDREN;
 }
 
+/* The number of child j of block `block` (bit k: the upper half on axis k). */
+static uint64_t child_number(unsigned block, unsigned j)
+{
+    return ((uint64_t)block << BLOCK_BITS) + j;
+}
+
 /* Which children of cell c in block `block` are covered whole by one candidate. A child's
  * farthest point from x is, on each axis, the farther end of its half; so per candidate all
  * children's squared farthest distances are sums of 2 values per axis, built child by child
@@ -436,7 +442,7 @@ static vpds_status drop_outside_children(vpdsi_mps *m, const vpdsi_ctx *ctx, uns
         double clo[VPDS_MAX_DIM], chi[VPDS_MAX_DIM], cm[VPDS_MAX_DIM], half, phi_c = phi;
         int found = 1;
         if (bit_set(covered, b)) continue;
-        child_coords(d, c, ((uint64_t)block << BLOCK_BITS) + b, split, cc);
+        child_coords(d, c, child_number(block, b), split, cc);
         half = 0.5 * sqrt(vpdsi_lattice_box(&m->run.geom, split ? level + 1 : level, cc, clo, chi));
         for (k = 0; k < d; k++) cm[k] = 0.5 * (clo[k] + chi[k]);
         if (split) {
@@ -577,7 +583,7 @@ static vpds_status flag_uncovered(vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned l
         int found = 0;
         flag[b] = 0;
         if (bit_set(covered, b) || bit_set(cov_c, b)) continue;
-        child_coords(d, c, ((uint64_t)block << BLOCK_BITS) + b, split, cc);
+        child_coords(d, c, child_number(block, b), split, cc);
         vpdsi_lattice_box(&m->run.geom, split ? level + 1 : level, cc, clo, chi);
         if ((e = vpdsi_uncovered_in(&m->unc, ctx, m->run.t, clo, chi, 0.0, &found)) != VPDS_OK)
             return e;
@@ -609,7 +615,7 @@ static vpds_status sweep_block(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_
     for (b = 0; b < children; b++) {
         if (bit_set(covered, b)) continue;
         if (pb->two_radii) m->unc.flag[run->next.count] = flag[b];
-        child_coords(d, c, ((uint64_t)block << BLOCK_BITS) + b, split, cc);
+        child_coords(d, c, child_number(block, b), split, cc);
         vpdsi_cells_push(&run->next, d, cc);
     }
     return VPDS_OK;
@@ -658,7 +664,7 @@ static vpds_status sweep_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, int
 {
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_run *run = &m->run;
-    unsigned children = split ? 1u << pb->dim : 1u; /* n <= CHUNK >> (d - 8): no overflow */
+    unsigned children = split ? 1u << pb->dim : 1u; /* past 8D sweep_step caps n */
     int varying = ctx->st->sizing.kind != VPDSI_SIZING_CONSTANT;
     /* r over the cell: for a rule that reads r(y), and for the reach of two radii' V */
     int need_r = varying && (vpdsi_rule_uses_y(pb->rule) || pb->two_radii);

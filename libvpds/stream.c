@@ -170,6 +170,15 @@ static int reserve_kids(vpdsi_stream *sm, vpdsi_mem *m)
                              sizeof(uint64_t));
 }
 
+/* The reserved room of one split: its children's centres (2^d * d), g and bounds (2^d each). */
+static void kid_arrays(const vpdsi_stream *sm, double **centres, double **g, double **ub)
+{
+    size_t children = (size_t)1 << sm->geom.dim;
+    *centres = sm->kids;
+    *g = sm->kids + children * (size_t)sm->geom.dim;
+    *ub = *g + children;
+}
+
 /* The stream's relative tolerance (vpds.h): looser with a domain. */
 static double stream_tolerance(const vpdsi_ctx *ctx)
 {
@@ -250,8 +259,9 @@ static vpds_status split_box(vpdsi_stream *sm, const vpdsi_ctx *ctx, region_sear
 {
     int d = sm->geom.dim, k;
     size_t w = 1 + 2 * (size_t)d, children = (size_t)1 << d, j;
-    double *cs = sm->kids, *gs = cs + children * (size_t)d, *ubs = gs + children;
+    double *cs, *gs, *ubs;
     vpds_status e;
+    kid_arrays(sm, &cs, &gs, &ubs);
     for (j = 0; j < children; j++)
         for (k = 0; k < d; k++)
             cs[j * (size_t)d + (size_t)k] = cb[k] + ((j >> k) & 1u ? hb[k] : -hb[k]);
@@ -499,11 +509,11 @@ static vpds_status split_if_coarse(vpdsi_stream *sm, const vpdsi_ctx *ctx, uint6
 {
     int d = sm->geom.dim, k, v3 = ctx->pb->algorithm >= 3;
     double key = rec_key(rec), h = 0, r, L = ctx->st->sizing.lipschitz, scale = key;
-    size_t children = (size_t)1 << d;
-    double *cs = sm->kids, *gs = cs + children * (size_t)d, *ubs = gs + children, hs[VPDS_MAX_DIM];
+    double *cs, *gs, *ubs, hs[VPDS_MAX_DIM];
     unsigned level = (unsigned)rec[1];
     uint64_t b, n = 0, *cc = sm->kid_cells, cr[VPDS_MAX_DIM];
     vpds_status e;
+    kid_arrays(sm, &cs, &gs, &ubs);
     *split = 0;
     if (v3 && scale > t_cap) scale = t_cap;
     if (!isfinite(scale) || level >= sm->max_level) return VPDS_OK;
