@@ -128,6 +128,14 @@ def main() -> None:
         row("libvpds 3D uniform (1e5)", vn, vs)
         row("crate fast_poisson 3D (1e5)", int(out[0]), float(out[1]),
             note=f"libvpds/peer samples-per-second: {(vn / vs) / (int(out[0]) / float(out[1])):.2f}")
+    # 4D (the high-dimension issue's yardstick: r = 0.06, about 7.5e4 samples; 0.1 with --quick)
+    r4 = 0.1 if QUICK else 0.06
+    n, sec, mem = vpds("uniform", 4, r4)
+    row(f"libvpds 4D uniform r={r4} (maximal)", n, sec, mem)
+    if "rust" in peers:
+        out = sh([str(peers["rust"]), "4", repr(r4), "1"]).split()
+        row(f"crate fast_poisson 4D r={r4} (not maximal)", int(out[0]), float(out[1]),
+            note=f"libvpds/peer samples-per-second: {(n / sec) / (int(out[0]) / float(out[1])):.2f}")
     n, sec, mem = vpds("uniform", 6, radius_for(3e3 if QUICK else 1e4, 6))
     row("libvpds 6D uniform (maximal)", n, sec, mem)
 

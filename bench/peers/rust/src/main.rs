@@ -12,6 +12,7 @@ fn main() {
     let n = match dim {
         2 => Poisson::<2>::new().with_dimensions([1.0, 1.0], radius).with_seed(seed).generate().len(),
         3 => Poisson::<3>::new().with_dimensions([1.0; 3], radius).with_seed(seed).generate().len(),
+        4 => Poisson::<4>::new().with_dimensions([1.0; 4], radius).with_seed(seed).generate().len(),
         6 => Poisson::<6>::new().with_dimensions([1.0; 6], radius).with_seed(seed).generate().len(),
         _ => panic!("dim"),
     };
