@@ -2,7 +2,8 @@
  * stays small), then the output's invariants: conflict-free, inside the box, covered.
  * Modes (first byte): 255 any dim, 254 any box, 253 any rule, 252 any radius, 251 an L too
  * small, 250 any inhibition, 249 a bad struct size, 248 periodic axes, 247 periodic axes and two
- * radii (inhibition < coverage). */
+ * radii (inhibition < coverage), 246 an estimate at any scale and a memory limit (lifted after
+ * the run, which must then finish as if there had been none). */
 #include "fuzz_common.h"
 
 typedef struct { double a, slope; int dim; } ramp_t;
@@ -17,6 +18,25 @@ static int ramp_batch(const double *x, size_t n, double *out, void *u)
     size_t i;
     for (i = 0; i < n; i++) out[i] = r->a + r->slope * fabs(x[i * (size_t)r->dim]);
     return 0;
+}
+
+/* An estimate is OK with every field >= 0 (never NaN), or a refusal of t with a message. */
+static void check_estimate_and_limit(vpds_sampler *s, bytes_t *b)
+{
+    vpds_run_estimate e;
+    double t = take_double(b, 0.2, 4, 1);
+    vpds_status st = vpds_estimate(s, t, &e);
+    check_status(st);
+    if (st == VPDS_OK) {
+        FUZZ_ASSERT(e.samples >= 0 && e.base_cells >= 1 && e.cells >= 0 && e.bytes > 0,
+                    "estimate at t = %g: %g samples, %g base cells, %g cells, %g bytes", t, e.samples,
+                    e.base_cells, e.cells, e.bytes);
+    } else {
+        FUZZ_ASSERT(st == VPDS_ERR_INVALID_ARGUMENT && vpds_last_error(s)[0] != 0,
+                    "estimate at t = %g: status %d, %s", t, (int)st, vpds_last_error(s));
+    }
+    /* 1 KB to 64 MB: refused up front, failed mid-run, or enough */
+    vpds_set_memory_limit(s, ((size_t)1 << (10 + take_u8(b) % 16)) + take_u32(b) % 1024);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
@@ -80,8 +100,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             return 0;
         }
     }
+    if (mode == 246) check_estimate_and_limit(s, &b);
     for (calls = 0; calls < 100 && (st = vpds_run(s)) == VPDS_PAUSED; calls++) {}
     check_status(st);
+    if (mode == 246 && st == VPDS_ERR_OUT_OF_MEMORY) {
+        FUZZ_ASSERT(strstr(vpds_last_error(s), "memory limit") != NULL, "out of memory under a limit "
+                    "without saying so: %s", vpds_last_error(s));
+        vpds_set_memory_limit(s, 0);
+        for (calls = 0; calls < 100 && (st = vpds_run(s)) == VPDS_PAUSED; calls++) {}
+        check_status(st);
+    }
     check_samples_on(s, lo, hi, d.rule, d.inhibition, periodic);
     if (st == VPDS_OK) {
         FUZZ_ASSERT(vpds_get_stats(s).maximal, "run returned OK but not maximal");

@@ -217,6 +217,29 @@ VPDS_API const double *vpds_scales(const vpds_sampler *sampler);
 VPDS_API const uint8_t *vpds_flags(const vpds_sampler *sampler);
 VPDS_API vpds_stats vpds_get_stats(const vpds_sampler *sampler);
 
+/* ---- Before a run: how large it will be, and a limit on the memory it may take. */
+/* An estimate of a maximal run at scale t (not a bound: within a factor of about 2 in 1D-8D,
+ * larger errors for small or thin boxes and domains). samples: the jamming density of random
+ * sequential addition integrated over the box (and the domain) at the inhibition radius;
+ * cells: most active cells at once; bytes: the peak of vpds_stats.peak_bytes, from per-cell and
+ * per-sample costs measured in every dimension. A count past what a double holds is +INFINITY. */
+typedef struct vpds_run_estimate {
+    double samples;
+    double base_cells;  /* cells of level 0 (exact for the current r_max) */
+    double cells;
+    double bytes;
+    double reserved[4];
+} vpds_run_estimate;
+/* Fill *out for a maximal run at scale t (t > 0; 0: the scale vpds_run would sample). A
+ * sizing or domain function is called at 4096 fixed points of the box (the samples do not
+ * change; vpds_stats' call counts do); a bad value is its usual error. */
+VPDS_API vpds_status vpds_estimate(vpds_sampler *sampler, double t, vpds_run_estimate *out);
+/* Hold at most `bytes` (0: no limit, the default). A run or refinement whose estimate exceeds
+ * the limit is refused before it starts (VPDS_ERR_OUT_OF_MEMORY, the estimate in
+ * vpds_last_error); past the estimate, an allocation that would exceed the limit fails as the
+ * allocator would, and the sampler is left as after any allocation failure. */
+VPDS_API vpds_status vpds_set_memory_limit(vpds_sampler *sampler, size_t bytes);
+
 /* ---- Grid sizing: values at the nodes of a regular grid over [lo, hi], multilinear between. */
 typedef struct vpds_grid_desc {
     uint32_t cookie;

@@ -17,6 +17,19 @@ double vpdsi_lattice_box(const vpdsi_lattice *g, unsigned level, const uint64_t 
     return diag2;
 }
 
+double vpdsi_lattice_base_side(double reach, int dim) { return reach / sqrt((double)dim) * (1 - 1e-9); }
+
+double vpdsi_lattice_base_count(int dim, const double *lo, const double *hi, double side)
+{
+    double total = 1;
+    int k;
+    for (k = 0; k < dim; k++) {
+        double cells = ceil((hi[k] - lo[k]) / side);
+        total *= cells < 1 ? 1 : cells;
+    }
+    return total;
+}
+
 unsigned vpdsi_bit_length(uint64_t n)
 {
     unsigned b = 0;

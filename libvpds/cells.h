@@ -36,6 +36,12 @@ typedef struct vpdsi_lattice {
 double vpdsi_lattice_box(const vpdsi_lattice *g, unsigned level, const uint64_t *c, double *lo,
                          double *hi);
 
+/* Side of the base cells of a run whose largest disk reaches `reach` (t * coverage * r_max):
+ * a diagonal just under it, so that a sample covers a cell of its own size. */
+double vpdsi_lattice_base_side(double reach, int dim);
+/* Base cells of that side over [lo, hi] (at least 1 per axis), as a double: it may be huge. */
+double vpdsi_lattice_base_count(int dim, const double *lo, const double *hi, double side);
+
 /* Bits needed to hold values below n (at least 1). */
 unsigned vpdsi_bit_length(uint64_t n);
 #endif

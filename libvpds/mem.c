@@ -24,10 +24,19 @@ void vpdsi_mem_init(vpdsi_mem *m, const vpds_allocator *a)
     }
 }
 
+/* Whether `more` bytes fit under the limit (set by vpds_set_memory_limit). */
+static int within_limit(vpdsi_mem *m, size_t more)
+{
+    if (m->limit == 0 || (m->held <= m->limit && more <= m->limit - m->held)) return 1;
+    m->limit_hit = 1;
+    return 0;
+}
+
 void *vpdsi_mem_alloc(vpdsi_mem *m, size_t size)
 {
     void *p;
     if (size == 0) size = 1;
+    if (!within_limit(m, size)) return NULL;
     p = m->a.alloc(size, m->a.user);
     if (p) {
         m->held += size;
@@ -64,6 +73,7 @@ int vpdsi_mem_reserve(vpdsi_mem *m, void **p, size_t *cap, size_t need, size_t e
     }
     old_bytes = *cap * elem;
     if (*p && m->a.realloc) {
+        if (!within_limit(m, new_bytes - old_bytes)) return -1;
         q = m->a.realloc(*p, old_bytes, new_bytes, m->a.user);
         if (!q) return -1;
         m->held += new_bytes - old_bytes;

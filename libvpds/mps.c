@@ -110,7 +110,7 @@ static vpds_status setup(vpdsi_mps *m, const vpdsi_ctx *ctx, int keep_tree)
     vpdsi_run *run = &m->run;
     vpds_status e;
     int d = pb->dim, k;
-    double target = run->t * pb->coverage * st->sizing.rmax / sqrt((double)d) * (1 - 1e-9);
+    double target = vpdsi_lattice_base_side(run->t * pb->coverage * st->sizing.rmax, d);
     uint64_t total = 1;
     unsigned max_level = 62;
     run->geom.dim = d;

@@ -1,8 +1,10 @@
 /* Public entry points: lifetime, fixed points, runs, the stream, results. Every call checks its
  * arguments and leaves the sampler consistent on error. */
 #include "sampler.h"
+#include "estimate.h"
 #include "rules.h"
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 int vpdsi_sampler_live(const vpds_sampler *s) { return s && s->magic == VPDSI_SAMPLER_MAGIC; }
@@ -96,18 +98,47 @@ static vpds_status ensure_rmax(vpds_sampler *s)
                                       sizeof s->store.err);
 }
 
+/* A run about to start at scale t whose estimate exceeds the memory limit is refused. */
+static vpds_status check_memory_limit(vpds_sampler *s, double t)
+{
+    vpds_run_estimate e;
+    vpds_status st;
+    if (s->mem.limit == 0) return VPDS_OK;
+    st = vpdsi_estimate_run(&s->pb, &s->store.sizing, &s->domain, t, sizeof *s, &e, s->store.err,
+                            sizeof s->store.err);
+    if (st != VPDS_OK || !(e.bytes > (double)s->mem.limit)) return st;
+    vpdsi_store_error(&s->store, "a maximal run at scale t = %g needs about %.3g bytes (%.3g samples,"
+                      " %.3g cells; vpds_estimate), above the memory limit of %zu bytes "
+                      "(vpds_set_memory_limit)", t, e.bytes, e.samples, e.cells, s->mem.limit);
+    return VPDS_ERR_OUT_OF_MEMORY;
+}
+
+/* An allocation refused for the limit says so, after what the failing site said. */
+vpds_status vpdsi_sampler_note_limit(vpds_sampler *s, vpds_status st)
+{
+    size_t len;
+    if (st != VPDS_ERR_OUT_OF_MEMORY || !s->mem.limit_hit) return st;
+    len = strlen(s->store.err);
+    snprintf(s->store.err + len, sizeof s->store.err - len, "%sthe memory limit of %zu bytes "
+             "(vpds_set_memory_limit) was reached", len ? ": " : "", s->mem.limit);
+    return st;
+}
+
 vpds_status vpdsi_sampler_run(vpds_sampler *s)
 {
     vpdsi_ctx c = context(s);
     vpdsi_work w;
     vpds_status st;
     s->store.err[0] = 0;
-    if ((st = ensure_rmax(s)) != VPDS_OK) return st;
+    s->mem.limit_hit = 0;
+    if ((st = ensure_rmax(s)) != VPDS_OK) return vpdsi_sampler_note_limit(s, st);
+    if (s->mps.run.phase == VPDSI_IDLE && (st = check_memory_limit(s, s->mps.run.t)) != VPDS_OK)
+        return st;
     w.budget = s->budget;
     w.progress = s->progress;
     w.user = s->progress_user;
     w.keep_tree = s->stream.active;
-    return vpdsi_mps_run(&s->mps, &c, &w);
+    return vpdsi_sampler_note_limit(s, vpdsi_mps_run(&s->mps, &c, &w));
 }
 
 void vpdsi_sampler_start_at(vpds_sampler *s, double t)
@@ -153,11 +184,12 @@ vpds_status vpds_next(vpds_sampler *s, double t_min, double *x_out, double *t_ou
                           "VPDS_OK)", run->t);
         return VPDS_ERR_STATE;
     }
-    if ((st = ensure_rmax(s)) != VPDS_OK) return st;
+    s->mem.limit_hit = 0;
+    if ((st = ensure_rmax(s)) != VPDS_OK) return vpdsi_sampler_note_limit(s, st);
     c = context(s);
     st = vpdsi_stream_next(&s->stream, &c, t_min, run->phase == VPDSI_DONE ? run->t : INFINITY,
                            x_out, &t);
-    if (st != VPDS_OK) return st;
+    if (st != VPDS_OK) return vpdsi_sampler_note_limit(s, st);
     *t_out = t;
     /* the set is now maximal at t (Section 4.2): a later vpds_refine goes below it */
     vpdsi_mps_release_cells(&s->mps, &s->store);
@@ -192,7 +224,37 @@ vpds_status vpds_add_points(vpds_sampler *s, const double *x, const double *r, s
             return VPDS_ERR_INVALID_ARGUMENT;
         }
     }
-    return vpdsi_store_add_fixed(&s->store, x, r, n);
+    s->mem.limit_hit = 0;
+    return vpdsi_sampler_note_limit(s, vpdsi_store_add_fixed(&s->store, x, r, n));
+}
+
+vpds_status vpds_estimate(vpds_sampler *s, double t, vpds_run_estimate *out)
+{
+    vpds_status st;
+    if (!vpdsi_sampler_live(s)) return VPDS_ERR_INVALID_ARGUMENT;
+    s->store.err[0] = 0;
+    if (!out) {
+        vpdsi_store_error(&s->store, "vpds_estimate: out is NULL");
+        return VPDS_ERR_INVALID_ARGUMENT;
+    }
+    memset(out, 0, sizeof *out);
+    if (t == 0) t = s->mps.run.t;
+    if (!(t > 0) || !isfinite(t) || !vpdsi_scale_ok(t * s->pb.coverage)) {
+        vpdsi_store_error(&s->store, "vpds_estimate: t = %g must be finite and > 0 (t * coverage "
+                          "within [1e-50, 1e50])", t);
+        return VPDS_ERR_INVALID_ARGUMENT;
+    }
+    s->mem.limit_hit = 0;
+    if ((st = ensure_rmax(s)) != VPDS_OK) return vpdsi_sampler_note_limit(s, st);
+    return vpdsi_estimate_run(&s->pb, &s->store.sizing, &s->domain, t, sizeof *s, out, s->store.err,
+                              sizeof s->store.err);
+}
+
+vpds_status vpds_set_memory_limit(vpds_sampler *s, size_t bytes)
+{
+    if (!vpdsi_sampler_live(s)) return VPDS_ERR_INVALID_ARGUMENT;
+    s->mem.limit = bytes;
+    return VPDS_OK;
 }
 
 vpds_status vpds_set_budget(vpds_sampler *s, uint64_t budget)

@@ -26,6 +26,8 @@ struct vpds_sampler {
 int vpdsi_sampler_live(const vpds_sampler *s);
 /* Run Algorithm 1 at the current scale (resets the error first). */
 vpds_status vpdsi_sampler_run(vpds_sampler *s);
+/* After an allocation failure caused by the memory limit, append so to the error message. */
+vpds_status vpdsi_sampler_note_limit(vpds_sampler *s, vpds_status st);
 /* The scale at which the next run starts (a tiling's scale), before any run. */
 void vpdsi_sampler_start_at(vpds_sampler *s, double t);
 /* Bounds of a sizing larger than this sampler's part of it (a tile of a tiling): the same

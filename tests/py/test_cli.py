@@ -150,13 +150,27 @@ def test_a_run_that_does_not_fit_is_refused_with_its_estimate():
 
 
 def test_estimate_is_close_to_the_count():
-    from vpds.estimate import estimate_run
     x = vpds_engine(radius=0.01).fill_space()
-    est = estimate_run(2, [0, 0], [1, 1], radius=0.01)
-    assert 0.85 < est.samples / len(x) < 1.15
+    est = vpds_engine(radius=0.01).estimate()
+    assert 0.85 < est.samples / len(x) < 1.15 and est.bytes > 0 and est.cells > 0
     ramp = lambda y: 0.01 + 0.1 * y[:, 0]  # noqa: E731
     x = vpds_engine(sizing=ramp, lipschitz=0.1).fill_space()
-    assert 0.8 < estimate_run(2, [0, 0], [1, 1], sizing=ramp).samples / len(x) < 1.2
+    assert 0.8 < vpds_engine(sizing=ramp, lipschitz=0.1).estimate().samples / len(x) < 1.2
+    # at half the scale, about 4x as many
+    assert 3.5 < vpds_engine(radius=0.01).estimate(0.5).samples / est.samples < 4.5
+
+
+def test_a_memory_limit_refuses_before_the_run_and_changes_nothing():
+    import vpds as v
+    ref = vpds_engine(radius=0.01).fill_space()
+    engine = vpds_engine(radius=0.01, memory_limit=100_000)
+    with pytest.raises(MemoryError, match="memory limit of 100000 bytes"):
+        engine.fill_space()
+    assert len(engine.points) == 0
+    engine = vpds_engine(radius=0.01, memory_limit=int(engine.estimate().bytes * 2))
+    assert np.array_equal(engine.fill_space(), ref)
+    with pytest.raises(ValueError, match="memory_limit = -1"):
+        v.PoissonDisk(2, memory_limit=-1)
 
 
 def vpds_engine(**kw):

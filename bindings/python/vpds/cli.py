@@ -19,7 +19,7 @@ from ._core import MAX_DIM, RULES, PoissonDisk, VpdsError
 from ._optional import MissingDependencyError, require
 from ._typing import SizingFunction
 from .cli_common import UsageError, domain_from_file, floats_arg, periodic_arg, sizing_from_expression
-from .estimate import available_memory, estimate_run
+from .estimate import available_memory
 from .files import check_output, write_points
 
 # the progress bar advances by this many samples per call into the library
@@ -51,16 +51,12 @@ def _sizing(args: argparse.Namespace, lo: npt.NDArray[np.float64], hi: npt.NDArr
     return None, meta, {}
 
 
-def _check_size(args: argparse.Namespace, engine: PoissonDisk, sizing: Optional[SizingFunction],
-                lo: npt.NDArray[np.float64], hi: npt.NDArray[np.float64], domain: object) -> float:
+def _check_size(args: argparse.Namespace, engine: PoissonDisk) -> float:
     """The expected count; refuse a run that will not fit in memory unless --force."""
     scale = min([1.0] + [float(v) for v in args.refine.split(",")]) if args.refine else 1.0
     if args.stream:
         return float(args.stream)
-    # a SizingGrid is callable on points too; the engine's domain (mask, polygon) evaluates in C
-    est = estimate_run(args.dim, lo, hi, radius=engine.radius, sizing=sizing,
-                       inhibition=args.inhibition, scale=scale,
-                       domain=engine._domain if domain is not None else None)
+    est = engine.estimate(scale)
     avail = available_memory()
     if avail is not None and est.bytes > avail and not args.force:
         raise UsageError(f"this run needs {est} (estimated), more than the {avail / 2**20:,.0f} MiB "
@@ -131,7 +127,7 @@ def cmd_sample(args: argparse.Namespace) -> int:
     if args.stream:
         from . import STREAM_DOMAIN_TOLERANCE, STREAM_TOLERANCE
         meta["stream_tolerance"] = STREAM_DOMAIN_TOLERANCE if domain is not None else STREAM_TOLERANCE
-    expected = _check_size(args, engine, sizing, lo, hi, domain)
+    expected = _check_size(args, engine)
     t0 = time.perf_counter()
     interrupted = False
     try:

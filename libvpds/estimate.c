@@ -1,0 +1,136 @@
+/* How large a maximal run will be before it runs. Samples: a maximal set of conflict distance
+ * s fills a fraction phi_d of space with balls of radius s/2 (random sequential addition's
+ * jamming density), so n = phi_d * integral of 1 / V_d(t * coverage * r(x) / 2) dx, more near
+ * open faces (the balls reach s/4 past them) and with two radii (a fit: (R_c / R_f)^(d/5)).
+ * Cells: the base grid (side t * coverage * r_max / sqrt(d)), or where r is smaller the cells a
+ * grid of the local radius would have, times the active cells per base cell runs show. */
+#include "estimate.h"
+#include "rng.h"
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define PROBES 4096
+#define BATCH 64
+#define PROBE_SEED UINT64_C(0x5eed0f0e57a11a7e)
+
+/* phi_d: d = 1 Renyi's constant, 2..6 Torquato, Uche and Stillinger (2006), 7 and 8 their fit;
+ * past 8D the 8D/7D ratio per axis (the same table as the Python binding's JAMMING_DENSITY). */
+static double jamming_density(int d)
+{
+    static const double phi[9] = {0, 0.7476, 0.5470, 0.3841, 0.2600, 0.1707, 0.1093, 0.0683, 0.0424};
+    return d <= 8 ? phi[d] : phi[8] * pow(0.6, d - 8);
+}
+
+/* Most active cells per base cell, measured with vpds_stats.peak_active_cells on uniform runs
+ * of 10^3-10^5 samples (2D: level 0 counted whole); past 8D doubled per axis. */
+static double cells_per_base_cell(int d)
+{
+    static const double c[9] = {0, 1, 1, 1.5, 4, 10, 11, 20, 32};
+    return d <= 8 ? c[d] : c[8] * pow(2, d - 8);
+}
+
+/* Bytes per active cell (bit-packed coordinates and their sweep buffers) and per sample
+ * (coordinates, r, t, flags, kd-tree and grid entries): fits of peak_bytes over 1D-11D runs. */
+#define BYTES_PER_CELL 16.0
+static double bytes_per_sample(int d)
+{
+    static const double b[6] = {0, 32, 52, 131, 206, 311};
+    return d <= 5 ? b[d] : 64.0 * d;
+}
+
+typedef struct probe_sums {
+    double inv_ball, inv_cell; /* sums of 1 / V(t R_c / 2) and of 1 / side(r)^d */
+    unsigned inside;
+} probe_sums;
+
+/* The domain at n probes: inside[i] = 1 where sdf <= 0; NaN is VPDS_ERR_DOMAIN. */
+static vpds_status probe_domain(vpdsi_domain *dm, int d, const double *x, size_t n, int *inside,
+                                char *err, size_t cap)
+{
+    size_t i;
+    for (i = 0; i < n; i++) {
+        double phi = 1;
+        inside[i] = 1;
+        if (!dm->fn) continue;
+        phi = dm->fn(x + i * (size_t)d, dm->user);
+        dm->calls++;
+        if (isnan(phi)) {
+            char where[512];
+            vpdsi_format_point(where, sizeof where, x + i * (size_t)d, d);
+            if (cap) snprintf(err, cap, "vpds_estimate: the domain function returned NaN at (%s)", where);
+            return VPDS_ERR_DOMAIN;
+        }
+        inside[i] = phi <= 0;
+    }
+    return VPDS_OK;
+}
+
+static vpds_status probe_batch(const vpdsi_problem *pb, vpdsi_sizing *sz, vpdsi_domain *dm,
+                               double t, vpdsi_rng *rng, probe_sums *sums, char *err, size_t cap)
+{
+    double x[BATCH * VPDS_MAX_DIM], r[BATCH];
+    int inside[BATCH], d = pb->dim, k;
+    double ball = pow(3.14159265358979323846, d / 2.0) / tgamma(d / 2.0 + 1), root_d = sqrt((double)d);
+    size_t i;
+    vpds_status st;
+    for (i = 0; i < BATCH; i++)
+        for (k = 0; k < d; k++)
+            x[i * (size_t)d + (size_t)k] = pb->lo[k] + (pb->hi[k] - pb->lo[k]) * vpdsi_rng_unit(rng);
+    if ((st = probe_domain(dm, d, x, BATCH, inside, err, cap)) != VPDS_OK) return st;
+    if ((st = vpdsi_sizing_eval(sz, x, BATCH, r, err, cap)) != VPDS_OK) return st;
+    for (i = 0; i < BATCH; i++) {
+        if (!inside[i]) continue;
+        sums->inside++;
+        sums->inv_ball += 1 / (ball * pow(0.5 * t * pb->coverage * r[i], d));
+        sums->inv_cell += pow(root_d / (t * pb->coverage * r[i]), d);
+    }
+    return VPDS_OK;
+}
+
+/* Samples near an open face: their balls of radius s/2 reach about s/4 past it, as if each
+ * open axis were longer by s/2; s is the typical reach, (mean of 1/side^d)^(-1/d) sqrt(d). */
+static double face_factor(const vpdsi_problem *pb, double inv_cell_sum)
+{
+    double factor = 1, reach;
+    int k;
+    if (!(inv_cell_sum > 0)) return 1;
+    reach = sqrt((double)pb->dim) * pow(inv_cell_sum / PROBES, -1.0 / pb->dim);
+    for (k = 0; k < pb->dim; k++)
+        if (pb->period[k] == 0) factor *= 1 + reach / (2 * (pb->hi[k] - pb->lo[k]));
+    return factor;
+}
+
+vpds_status vpdsi_estimate_run(const vpdsi_problem *pb, vpdsi_sizing *sz, vpdsi_domain *dm,
+                               double t, size_t fixed_bytes, vpds_run_estimate *out, char *err,
+                               size_t cap)
+{
+    probe_sums sums;
+    vpdsi_rng rng;
+    double volume = 1, side, base, fraction, cells;
+    int d = pb->dim, k, b;
+    vpds_status st;
+    memset(out, 0, sizeof *out);
+    memset(&sums, 0, sizeof sums);
+    vpdsi_rng_seed(&rng, PROBE_SEED);
+    for (b = 0; b < PROBES / BATCH; b++)
+        if ((st = probe_batch(pb, sz, dm, t, &rng, &sums, err, cap)) != VPDS_OK) return st;
+    for (k = 0; k < d; k++) volume *= pb->hi[k] - pb->lo[k];
+    side = vpdsi_lattice_base_side(t * pb->coverage * sz->rmax, d);
+    base = vpdsi_lattice_base_count(d, pb->lo, pb->hi, side);
+    /* a domain no probe meets still has its straddling cells: count one probe's share */
+    fraction = (sums.inside > 0 ? sums.inside : 1) / (double)PROBES;
+    cells = volume * sums.inv_cell / PROBES;
+    if (cells < base * fraction) cells = base * fraction;
+    out->samples = jamming_density(d) * volume * sums.inv_ball / PROBES *
+                   pow(pb->coverage / pb->inhibition, d / 5.0) * face_factor(pb, sums.inv_cell);
+    out->base_cells = base;
+    out->cells = cells_per_base_cell(d) * cells;
+    out->bytes = BYTES_PER_CELL * out->cells + bytes_per_sample(d) * out->samples;
+    /* two radii keep the index of the uncovered region, a domain the cells along its boundary:
+     * about as much again each, measured */
+    if (pb->two_radii) out->bytes *= 2;
+    if (dm->fn) out->bytes *= 2;
+    out->bytes += (double)fixed_bytes;
+    return VPDS_OK;
+}
