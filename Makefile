@@ -30,7 +30,7 @@ SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-
 # Fuzzing: the harnesses FUZZERS, from FUZZ_DIR/fuzz_<name>.c with seeds in FUZZ_DIR/corpus/<name>,
 # built and run in FUZZ_OUT (logs, grown corpora, and libFuzzer's crash-, leak-, timeout- and oom-
 # inputs in FUZZ_OUT/artifacts). tests/fuzz_fails.sh points these at harnesses that must fail.
-FUZZERS ?= run grid sequence sizing domain
+FUZZERS ?= run grid sequence sizing domain tiles
 FUZZ_DIR ?= fuzz
 FUZZ_OUT ?= $(BUILD)/fuzz
 FUZZ_SECONDS ?= 120
@@ -57,7 +57,7 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 VALGRIND := valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect
 
 .PHONY: all test demo deps install clean bench check-c check-flann check-py check-sanitizers check-abi \
-	check-valgrind check-determinism check-fuzz check-fuzz-fails fuzz amalgamate check-consumers wheel check-wheel check-types
+	check-valgrind check-determinism check-fuzz check-fuzz-fails fuzz amalgamate check-tsan check-consumers wheel check-wheel check-types
 all: $(SHARED) $(STATIC) $(BUILD)/vpds.pc
 
 $(BUILD)/obj/%.o: libvpds/%.c $(LIB_HDR)
@@ -66,7 +66,7 @@ $(BUILD)/obj/%.o: libvpds/%.c $(LIB_HDR)
 
 $(SHARED): $(LIB_OBJ) libvpds/vpds.map
 	$(CC) -shared -Wl,-soname,libvpds.so.$(SOMAJOR) -Wl,--version-script=libvpds/vpds.map \
-	  -o $@ $(LIB_OBJ) -lm
+	  -o $@ $(LIB_OBJ) -lm -pthread
 	ln -sf libvpds.so.$(VERSION) $(BUILD)/libvpds.so.$(SOMAJOR)
 	ln -sf libvpds.so.$(SOMAJOR) $(BUILD)/libvpds.so
 
@@ -80,19 +80,19 @@ $(BUILD)/vpds.pc: libvpds/vpds.pc.in
 
 $(BUILD)/tests/%: tests/%.c tests/check.h $(STATIC)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_TEST) $< -o $@ $(STATIC) -lm
+	$(CC) $(CFLAGS_TEST) $< -o $@ $(STATIC) -lm -pthread
 
 $(SAMPLE_TOOL): tests/tools/sample_tool.c $(STATIC)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_TEST) $< -o $@ $(STATIC) -lm
+	$(CC) $(CFLAGS_TEST) $< -o $@ $(STATIC) -lm -pthread
 
 $(FLANN_TEST): tests/flann_kdtree.c tests/check.h $(STATIC)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_TEST) $< -o $@ $(STATIC) -lflann -lm
+	$(CC) $(CFLAGS_TEST) $< -o $@ $(STATIC) -lflann -lm -pthread
 
 $(BUILD)/demo/figure1: examples/figure1.c $(STATIC)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_TEST) $< -o $@ $(STATIC) -lm
+	$(CC) $(CFLAGS_TEST) $< -o $@ $(STATIC) -lm -pthread
 
 # The Python binding compiles the library as one translation unit (bindings/python/vpds/_build.py):
 # a static name defined in two files breaks its build, and no C test would notice, so check-c
@@ -118,11 +118,11 @@ $(BUILD)/fuzz/obj/%.o: libvpds/%.c $(LIB_HDR)
 
 $(FUZZ_OUT)/fuzz_%: $(FUZZ_DIR)/fuzz_%.c fuzz/fuzz_common.h $(FUZZ_LIB_OBJ)
 	@mkdir -p $(dir $@)
-	clang $(FUZZ_FLAGS) $< $(FUZZ_LIB_OBJ) -lm -o $@
+	clang $(FUZZ_FLAGS) $< $(FUZZ_LIB_OBJ) -lm -pthread -o $@
 
 $(BUILD)/fuzz/replay_%: fuzz/fuzz_%.c fuzz/replay.c fuzz/fuzz_common.h $(STATIC)
 	@mkdir -p $(dir $@)
-	$(CC) -std=c99 -O2 -g -Iinclude -ffp-contract=off fuzz/replay.c $< -o $@ $(STATIC) -lm
+	$(CC) -std=c99 -O2 -g -Iinclude -ffp-contract=off fuzz/replay.c $< -o $@ $(STATIC) -lm -pthread
 
 # make fuzz: each harness for FUZZ_SECONDS (one line each; a finding fails the target and is
 # shown), growing FUZZ_OUT/corpus_<name> from the seeds
@@ -197,6 +197,16 @@ check-sanitizers:
 	$(MAKE) --no-print-directory -j $(JOBS) BUILD=$(BUILD)/san OPT=-O1 EXTRA_CFLAGS="$(SAN_FLAGS)" \
 	  CC="$(CC) $(SAN_FLAGS)" check-c
 
+# The threaded paths (vpds_tiling_run) under ThreadSanitizer: the library and test_parallel
+# built with -fsanitize=thread (a separate build); a data race fails the program.
+TSAN_TEST := $(BUILD)/tsan/test_parallel
+$(TSAN_TEST): tests/test_parallel.c $(LIB_SRC) $(LIB_HDR)
+	@mkdir -p $(dir $@)
+	$(CC) -std=c99 -O1 -g -fsanitize=thread -ffp-contract=off -Iinclude -Ilibvpds $(LIB_SRC) $< -o $@ -lm -pthread
+
+check-tsan: $(TSAN_TEST)
+	TSAN_OPTIONS=halt_on_error=1:exitcode=66 $(TSAN_TEST)
+
 # A fresh machine: install the dependencies once (the stamp remembers), then every check.
 DEPS_STAMP := $(VENV)/.deps-installed
 $(DEPS_STAMP): tools/deps.sh tests/requirements.txt | $(PY)
@@ -214,6 +224,7 @@ test: $(DEPS_STAMP)
 	@$(PHASE) consumers $(SUBMAKE) check-consumers
 	@$(PHASE) wheel $(SUBMAKE) check-wheel
 	@$(PHASE) sanitizers $(SUBMAKE) check-sanitizers
+	@$(PHASE) threads $(SUBMAKE) check-tsan
 	@$(PHASE) valgrind $(SUBMAKE) check-valgrind
 	@$(PHASE) determinism $(SUBMAKE) check-determinism
 	@$(PHASE) fuzz $(SUBMAKE) check-fuzz
@@ -226,7 +237,7 @@ demo: $(BUILD)/demo/figure1 $(VENV)/.vpds-installed
 
 $(BUILD)/bench/bench: bench/bench.c $(STATIC)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_TEST) -O2 $< -o $@ $(STATIC) -lm
+	$(CC) $(CFLAGS_TEST) -O2 $< -o $@ $(STATIC) -lm -pthread
 
 # Speed and memory beside the peers (installed by the script itself); BENCH_ARGS=--quick for a short run.
 bench: $(BUILD)/bench/bench $(DEPS_STAMP) $(VENV)/.vpds-installed

@@ -1,7 +1,8 @@
 #define _POSIX_C_SOURCE 199309L
 /* libvpds workloads for `make bench`. Prints "name n seconds peak_bytes" per line.
  * usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION | ramp RULE | floor N DIM
- *        | annulus RADIUS (a domain) | stream DIM RADIUS N STEPS (prints one line per N/STEPS samples: the cost along n) */
+ *        | annulus RADIUS (a domain) | stream DIM RADIUS N STEPS (prints one line per N/STEPS samples: the cost along n)
+ *        | threads DIM RADIUS TILES THREADS (vpds_tiling_run of TILES per axis on THREADS threads) */
 #include "rng.h"
 #include "vpds.h"
 #include <stdio.h>
@@ -71,6 +72,33 @@ static int stream(vpds_desc *d, size_t n, size_t steps)
     return 0;
 }
 
+/* A whole tiling (tiles per axis) on some threads: its wall time against one run's. */
+static int tiled(vpds_desc *d, uint64_t per_axis, int threads)
+{
+    vpds_tiling_desc td = vpds_default_tiling_desc();
+    vpds_tiling_run_desc rd = vpds_default_tiling_run_desc();
+    uint64_t tiles[VPDS_MAX_DIM];
+    vpds_tiling *tg;
+    vpds_tiled *out;
+    char msg[512];
+    double t0;
+    int k;
+    for (k = 0; k < d->dim; k++) tiles[k] = per_axis;
+    td.sampler = d;
+    td.tiles = tiles;
+    rd.threads = threads;
+    if (vpds_tiling_create(&td, &tg) != VPDS_OK) return 1;
+    t0 = now();
+    if (vpds_tiling_run(tg, &rd, &out, msg, sizeof msg) != VPDS_OK) {
+        fprintf(stderr, "threads: %s\n", msg);
+        return 1;
+    }
+    printf("threads %zu %.6f 0\n", vpds_tiled_count(out), now() - t0);
+    vpds_tiled_destroy(out);
+    vpds_tiling_destroy(tg);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     vpds_desc d = vpds_default_desc();
@@ -85,6 +113,11 @@ int main(int argc, char **argv)
         d.radius = atof(argv[3]);
         d.inhibition = atof(argv[4]);
         return run("tworadii", &d);
+    }
+    if (argc >= 6 && !strcmp(argv[1], "threads")) {
+        d.dim = atoi(argv[2]);
+        d.radius = atof(argv[3]);
+        return tiled(&d, (uint64_t)atoi(argv[4]), atoi(argv[5]));
     }
     if (argc >= 3 && !strcmp(argv[1], "annulus")) {
         d.radius = atof(argv[2]);

@@ -150,7 +150,20 @@ def main() -> None:
     nb, sb, _ = vpds("uniform", 2, r_a)
     row(f"libvpds 2D annulus (domain callback), r={r_a}", n, sec, mem,
         note=f"time/sample = {(sec / n) / (sb / nb):.2f}x the full box ({nb / sb:,.0f}/s)")
+    thread_rows(row)
     stream_rows()
+
+
+def thread_rows(row) -> None:
+    """vpds_tiling_run on 1 and 2 threads beside one vpds_run of the same box and radius: the
+    speed-up of threads (the tiling's seams cost the one-thread overhead)."""
+    cases = [(2, radius_for(1e5 if QUICK else 1e6, 2), 16), (3, radius_for(1e4 if QUICK else 1e5, 3), 4)]
+    for dim, r, per_axis in cases:
+        n, sec, _ = vpds("uniform", dim, r)
+        for threads in (1, 2):
+            tn, ts, _ = vpds("threads", dim, r, per_axis, threads)
+            row(f"libvpds {dim}D uniform, {per_axis}^{dim} tiles, {threads} thread(s)", tn, ts,
+                note=f"speed-up over one vpds_run ({n:,d} samples in {sec:.2f} s): {sec / ts:.2f}x")
 
 
 def stream_rows() -> None:

@@ -408,6 +408,49 @@ VPDS_API vpds_status vpds_tile_create(const vpds_tiling *tiling, uint64_t tile,
                                       const vpds_grid *sizing_window, vpds_sampler **out,
                                       size_t *n_fixed, char *msg, size_t cap);
 
+/* ---- A whole tiling on several threads (libvpds/parallel.c): every tile run as above, phase
+ * after phase, the tiles of a phase side by side. The points are the same bytes for any number
+ * of threads and any order in which tasks finish: a tile's run depends on its seed and on its
+ * dependencies' samples alone, and those are done in earlier phases. */
+/* One task of a phase: run task number `task` of the batch. */
+typedef void (*vpds_task_fn)(void *batch, uint64_t task);
+/* An engine's job system: call run(batch, i) once for each i in 0..n-1, on any threads and in
+ * any order, and return when every call has returned. */
+typedef void (*vpds_executor_fn)(vpds_task_fn run, void *batch, uint64_t n, void *user);
+
+typedef struct vpds_tiling_run_desc {
+    uint32_t cookie;      /* set by vpds_default_tiling_run_desc; do not change */
+    uint32_t struct_size;
+    int threads;          /* 0 or 1: the calling thread alone; n > 1: n POSIX threads (the
+                             calling one and n - 1 the library starts and joins per phase) */
+    vpds_executor_fn executor; /* instead of threads: the caller's job system (NULL: none) */
+    void *executor_user;
+    int callbacks_thread_safe; /* non-zero: the sizing and domain callbacks may run on several
+                                  threads at once; else a tiling with a callback runs serially */
+    int allocator_thread_safe; /* non-zero: the tiling's allocator may be called from several
+                                  threads at once; else the library calls it under its own lock */
+} vpds_tiling_run_desc;
+
+/* The samples of a tiling run: every tile's own samples, in the order (phase, tile, insertion). */
+typedef struct vpds_tiled vpds_tiled;
+
+VPDS_API vpds_tiling_run_desc vpds_default_tiling_run_desc(void);
+/* Run every tile (a tiling with sizing_per_tile is refused: its windows come from the caller).
+ * On failure (a tile's error, out of memory) nothing is kept and msg (cap bytes) names the
+ * first failing tile in (phase, tile) order and why. */
+VPDS_API vpds_status vpds_tiling_run(const vpds_tiling *tiling, const vpds_tiling_run_desc *desc,
+                                     vpds_tiled **out, char *msg, size_t cap);
+VPDS_API void vpds_tiled_destroy(vpds_tiled *tiled);
+VPDS_API size_t vpds_tiled_count(const vpds_tiled *tiled);
+VPDS_API int vpds_tiled_dim(const vpds_tiled *tiled);
+/* count * dim doubles; r at each sample; the tile each belongs to. */
+VPDS_API const double *vpds_tiled_points(const vpds_tiled *tiled);
+VPDS_API const double *vpds_tiled_radii(const vpds_tiled *tiled);
+VPDS_API const uint64_t *vpds_tiled_tiles(const vpds_tiled *tiled);
+/* Threads that ran tiles at once: 1 when the run stayed serial (threads <= 1, or a callback not
+ * declared thread-safe, or a platform without POSIX threads); with an executor, 0. */
+VPDS_API int vpds_tiled_threads(const vpds_tiled *tiled);
+
 #ifdef __cplusplus
 }
 #endif

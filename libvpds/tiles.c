@@ -328,7 +328,7 @@ static size_t tiles_unique(uint64_t *v, size_t n)
 }
 
 /* The dependencies of a tile into buf (room for 3^dim - 1), ascending; returns their count. */
-static size_t tiles_deps_into(const vpds_tiling *t, uint64_t tile, uint64_t *buf)
+size_t vpdsi_tiling_deps_into(const vpds_tiling *t, uint64_t tile, uint64_t *buf)
 {
     uint64_t c[VPDS_MAX_DIM], nb, nc[VPDS_MAX_DIM];
     unsigned code, codes = tiles_codes(t->dim);
@@ -353,7 +353,7 @@ vpds_status vpds_tiling_deps(const vpds_tiling *t, uint64_t tile, uint64_t *out,
     m = t->mem; /* a copy: the tiling itself stays untouched */
     bytes = (size_t)tiles_codes(t->dim) * sizeof *buf;
     if (!(buf = (uint64_t *)vpdsi_mem_alloc(&m, bytes))) return VPDS_ERR_OUT_OF_MEMORY;
-    count = tiles_deps_into(t, tile, buf);
+    count = vpdsi_tiling_deps_into(t, tile, buf);
     *n = count;
     if (count > cap) {
         vpdsi_mem_free(&m, buf, bytes);
@@ -557,12 +557,14 @@ static vpds_status tiles_match_deps(const vpds_tiling *t, uint64_t tile, int pha
 /* The sampler of one tile, before its fixed points: the tiling's descriptor on the tile's box
  * and seed, with the whole sizing's bounds and the tiling's scale. */
 static vpds_status tiles_sampler(const vpds_tiling *t, uint64_t tile, const double *lo,
-                                 const double *hi, const vpds_grid *window, vpds_sampler **out,
+                                 const double *hi, const vpds_grid *window,
+                                 const vpds_allocator *allocator, vpds_sampler **out,
                                  char *msg, size_t cap)
 {
     vpds_desc td = t->desc;
     char inner[400];
     vpds_status st;
+    if (allocator) td.allocator = *allocator;
     td.lo = lo;
     td.hi = hi;
     td.seed = vpds_tiling_seed(t, tile);
@@ -586,10 +588,10 @@ static vpds_status tiles_sampler(const vpds_tiling *t, uint64_t tile, const doub
 static vpds_status tiles_add_fixed(const vpds_tiling *t, uint64_t tile, const uint64_t *c,
                                    const uint64_t *dep, size_t n_dep, const size_t *order,
                                    const vpds_tile_points *deps, const double *lo,
-                                   const double *hi, vpds_sampler *s, size_t *count, char *msg,
-                                   size_t cap)
+                                   const double *hi, const vpdsi_mem *mem, vpds_sampler *s,
+                                   size_t *count, char *msg, size_t cap)
 {
-    vpdsi_mem m = t->mem;
+    vpdsi_mem m = *mem;
     size_t nx = 0, n = tiles_gather(t, c, dep, n_dep, order, deps, lo, hi, NULL, NULL);
     double *fx = NULL, *fr = NULL;
     vpds_status st = VPDS_OK;
@@ -614,6 +616,14 @@ static vpds_status tiles_add_fixed(const vpds_tiling *t, uint64_t tile, const ui
 vpds_status vpds_tile_create(const vpds_tiling *t, uint64_t tile, const vpds_tile_points *deps,
                              size_t n_deps, const vpds_grid *window, vpds_sampler **out,
                              size_t *n_fixed, char *msg, size_t cap)
+{
+    return vpdsi_tile_create(t, tile, deps, n_deps, window, NULL, out, n_fixed, msg, cap);
+}
+
+vpds_status vpdsi_tile_create(const vpds_tiling *t, uint64_t tile, const vpds_tile_points *deps,
+                              size_t n_deps, const vpds_grid *window,
+                              const vpds_allocator *allocator, vpds_sampler **out,
+                              size_t *n_fixed, char *msg, size_t cap)
 {
     vpdsi_mem m;
     uint64_t c[VPDS_MAX_DIM] = {0}, *dep = NULL;
@@ -642,6 +652,7 @@ vpds_status vpds_tile_create(const vpds_tiling *t, uint64_t tile, const vpds_til
     phase = tiles_phase_of(t, c);
     tiles_box_of(t, c, lo, hi);
     m = t->mem;
+    if (allocator) vpdsi_mem_init(&m, allocator);
     dep_bytes = (size_t)tiles_codes(t->dim) * sizeof *dep;
     order_bytes = (size_t)tiles_codes(t->dim) * sizeof *order;
     dep = (uint64_t *)vpdsi_mem_alloc(&m, dep_bytes);
@@ -652,10 +663,11 @@ vpds_status vpds_tile_create(const vpds_tiling *t, uint64_t tile, const vpds_til
         st = VPDS_ERR_OUT_OF_MEMORY;
         goto done;
     }
-    n_dep = tiles_deps_into(t, tile, dep);
+    n_dep = vpdsi_tiling_deps_into(t, tile, dep);
     if ((st = tiles_match_deps(t, tile, phase, deps, n_deps, dep, n_dep, order, msg, cap)) != VPDS_OK ||
-        (st = tiles_sampler(t, tile, lo, hi, window, &s, msg, cap)) != VPDS_OK ||
-        (st = tiles_add_fixed(t, tile, c, dep, n_dep, order, deps, lo, hi, s, &count, msg, cap)) != VPDS_OK)
+        (st = tiles_sampler(t, tile, lo, hi, window, allocator, &s, msg, cap)) != VPDS_OK ||
+        (st = tiles_add_fixed(t, tile, c, dep, n_dep, order, deps, lo, hi, &m, s, &count, msg,
+                              cap)) != VPDS_OK)
         goto done;
     if (n_fixed) *n_fixed = count;
     *out = s;

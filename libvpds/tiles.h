@@ -20,4 +20,13 @@ struct vpds_tiling {
     double scale, margin;
     double lipschitz, rmin, rmax;    /* the whole sizing's, imposed on every tile's sampler */
 };
+
+/* The tiles this tile's run needs, ascending, into buf (3^dim - 1 entries); returns the count. */
+size_t vpdsi_tiling_deps_into(const vpds_tiling *t, uint64_t tile, uint64_t *buf);
+/* vpds_tile_create with another allocator for the tile (NULL: the tiling's): a parallel run's
+ * lock around the caller's allocator. */
+vpds_status vpdsi_tile_create(const vpds_tiling *t, uint64_t tile, const vpds_tile_points *deps,
+                              size_t n_deps, const vpds_grid *window,
+                              const vpds_allocator *allocator, vpds_sampler **out,
+                              size_t *n_fixed, char *msg, size_t cap);
 #endif

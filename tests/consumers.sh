@@ -75,7 +75,7 @@ for cc in "gcc -std=c99" "clang -std=c99" "g++ -x c++" "clang++ -x c++"; do
     -o "$out/single.o"
 done
 run gcc -std=c99 -shared -fPIC -fvisibility=hidden -O2 -ffp-contract=off -I"$single" "$single/vpds.c" \
-  -o "$out/libsingle.so" -lm
+  -o "$out/libsingle.so" -lm -pthread
 others=$(nm -D --defined-only "$out/libsingle.so" | awk '{print $3}' | grep -v '^vpds_' || true)
 [ -z "$others" ] || { echo "consumers: the single file exports more than vpds_*: $others" >&2; exit 1; }
 echo "summary: CMake package (find_package), add_subdirectory, FetchContent and the single file each build the" \

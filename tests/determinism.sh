@@ -16,7 +16,7 @@ pids=()
 for v in "${variants[@]}"; do # built side by side
   name=$(echo "$v" | tr ' =,' '___')
   command -v "${v%% *}" >/dev/null || { echo "determinism: ${v%% *} missing" >&2; exit 1; }
-  $v $common libvpds/*.c tests/tools/sample_tool.c -lm -o "$out/tool_$name" &
+  $v $common libvpds/*.c tests/tools/sample_tool.c -lm -pthread -o "$out/tool_$name" &
   pids+=($!)
 done
 for p in "${pids[@]}"; do wait "$p" || { echo "determinism: a build failed" >&2; exit 1; }; done

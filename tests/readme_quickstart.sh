@@ -9,10 +9,10 @@ awk '/^## C quick start/ {on = 1} on && /^```c$/ {grab = 1; next} grab && /^```$
      grab {print}' README.md > "$out/quick.c"
 [ -s "$out/quick.c" ] || { echo "readme_quickstart: no C block under '## C quick start'" >&2; exit 1; }
 ${CC:-gcc} -std=c99 -Wall -Wextra -Wpedantic -Werror -Iinclude "$out/quick.c" -o "$out/quick" \
-  "$BUILD/libvpds.a" -lm
+  "$BUILD/libvpds.a" -lm -pthread
 # and as C++, the way a C++ engine includes the header and calls the library
 ${CXX:-g++} -Wall -Wextra -Wpedantic -Werror -Iinclude -x c++ "$out/quick.c" -x none -o "$out/quick_cxx" \
-  "$BUILD/libvpds.a" -lm
+  "$BUILD/libvpds.a" -lm -pthread
 line=$("$out/quick")
 [ "$("$out/quick_cxx")" = "$line" ] || { echo "readme_quickstart: the C++ build prints otherwise" >&2; exit 1; }
 echo "$line" | grep -Eq '^[0-9]+ samples; the first at \(' \

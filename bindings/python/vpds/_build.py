@@ -45,7 +45,8 @@ ffibuilder.set_source(
     # compares the generated file's time only, which a C-only change leaves as it was)
     depends=[str(p) for p in sorted((ROOT / "libvpds").glob("*.[ch]"))] + [str(ROOT / "include" / "vpds.h")],
     # the library's determinism contract: no FMA contraction, no fast-math
-    extra_compile_args=["-std=c99", "-O2", "-ffp-contract=off", "-fvisibility=hidden"],
+    extra_compile_args=["-std=c99", "-O2", "-ffp-contract=off", "-fvisibility=hidden", "-pthread"],
+    extra_link_args=["-pthread"],  # vpds_tiling_run's threads
 )
 
 if __name__ == "__main__":
