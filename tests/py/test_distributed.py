@@ -87,6 +87,33 @@ def test_seams_periodic_two_radii_and_3d(tmp_path):
             A.Sizing(lambda y: np.full(len(y), 0.08), 0.0), (0, 0, 0), (1, 1, 1))
 
 
+@pytest.mark.parametrize("sizing", ["grid", "callable"])
+def test_tiling_run_on_threads_is_run_tile_over_the_order_and_the_dask_run(tmp_path, sizing):
+    """The C library's threads (vpds_tiling_run) give the bytes of the tiles run one by one,
+    for any number of workers, and the points of the Dask path's store."""
+    if sizing == "grid":
+        g = np.linspace(0.02, 0.05, 9)[:, None] * np.ones((1, 7))
+        spec = TilingSpec.make(2, (4, 3), u_bounds=(1.0, 0.8), sizing=g, rng=5)
+    else:
+        spec = TilingSpec.make(2, (4, 3), u_bounds=(1.0, 0.8), sizing=wave, lipschitz=WAVE_L,
+                               radius_max=0.04, rng=5)
+    tg = Tiling(spec)
+    done: dict[int, tuple] = {}
+    for tile in tg.order():
+        x, r, _ = tg.run_tile(tile, {k: done[k] for k in tg.deps(tile)})
+        done[tile] = (x, r)
+    ref = np.concatenate([done[k][0] for k in tg.order()])
+    for workers in (1, 2, 3, -1):
+        x, r, tiles = tg.run(workers=workers)
+        assert x.shape == ref.shape and np.array_equal(x, ref), workers
+        assert list(dict.fromkeys(tiles.tolist())) == [k for k in tg.order() if len(done[k][0])]
+    store = D.run_local(tmp_path / "t.zarr", spec)
+    xs, _, _ = store.to_numpy()
+    assert np.array_equal(np.unique(xs, axis=0), np.unique(ref, axis=0))
+    with pytest.raises(ValueError, match="workers = 0"):
+        tg.run(workers=0)
+
+
 def test_refused_tilings_name_the_argument(tmp_path):
     with pytest.raises(vpds.VpdsValueError, match=r"tiles\[0\] = 3: a periodic axis needs an even"):
         TilingSpec.make(2, (3, 4), radius=0.02, periodic=(True, False))

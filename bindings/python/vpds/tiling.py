@@ -259,6 +259,38 @@ class Tiling:
         """All tiles in an order that can run one after another: by phase, then index."""
         return sorted(range(self.count), key=lambda k: (self.phase(k), k))
 
+    def run(self, workers: int = 1) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64],
+                                           npt.NDArray[np.int64]]:
+        """Every tile, in this process: points (n, d), radii (n,) and the tile of each sample
+        (n,), in the order (phase, tile, insertion), by the C library's vpds_tiling_run on
+        `workers` threads (-1: every core; scipy's spelling). The same bytes for any number of
+        workers, and those of run_tile over order(). A Python sizing callable keeps the run on
+        the calling thread (the GIL; a numpy grid or a constant radius runs on every worker);
+        a GridSource sizing is refused (its windows are read per tile: use run_tile)."""
+        import os
+        if not isinstance(workers, (int, np.integer)) or isinstance(workers, bool) or \
+                not (workers == -1 or workers >= 1):
+            raise ValueError(f"workers = {workers!r}: must be an int >= 1, or -1 for every core")
+        threads = (os.cpu_count() or 1) if workers == -1 else int(workers)
+        rd = ffi.new("vpds_tiling_run_desc *", lib.vpds_default_tiling_run_desc())
+        rd.threads = min(threads, 256)
+        out = ffi.new("vpds_tiled **")
+        msg = ffi.new("char[]", 1024)
+        st = lib.vpds_tiling_run(self._t, rd, out, msg, 1024)
+        cause = take(self._owner, "_callback_error")
+        if st < 0 or cause is not None:
+            if cause is None:
+                _raise(st, ffi.string(msg).decode())
+            raise_failure(st, ffi.string(msg).decode(), cause, "sizing")
+        res = ffi.gc(out[0], lib.vpds_tiled_destroy)
+        n, d = int(lib.vpds_tiled_count(res)), self.spec.d
+        if n == 0:
+            return np.empty((0, d)), np.empty(0), np.empty(0, dtype=np.int64)
+        x = np.frombuffer(ffi.buffer(lib.vpds_tiled_points(res), n * d * 8), dtype=np.float64).reshape(n, d).copy()
+        r = np.frombuffer(ffi.buffer(lib.vpds_tiled_radii(res), n * 8), dtype=np.float64).copy()
+        k = np.frombuffer(ffi.buffer(lib.vpds_tiled_tiles(res), n * 8), dtype=np.uint64).astype(np.int64)
+        return x, r, k
+
     def window_range(self, tile: int) -> tuple[list[int], list[int]]:
         """Node offsets and counts of the grid window that covers this tile's core (with one
         node to spare on each side)."""
