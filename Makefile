@@ -204,8 +204,15 @@ $(TSAN_TEST): tests/test_parallel.c $(LIB_SRC) $(LIB_HDR)
 	@mkdir -p $(dir $@)
 	$(CC) -std=c99 -O1 -g -fsanitize=thread -ffp-contract=off -Iinclude -Ilibvpds $(LIB_SRC) $< -o $@ -lm -pthread
 
-check-tsan: $(TSAN_TEST)
+# and examples/engine_jobs.c: an engine's own job system as the executor, same bytes as one thread
+TSAN_EXAMPLE := $(BUILD)/tsan/engine_jobs
+$(TSAN_EXAMPLE): examples/engine_jobs.c $(LIB_SRC) $(LIB_HDR)
+	@mkdir -p $(dir $@)
+	$(CC) -std=c99 -O1 -g -fsanitize=thread -ffp-contract=off -Iinclude -Ilibvpds $(LIB_SRC) $< -o $@ -lm -pthread
+
+check-tsan: $(TSAN_TEST) $(TSAN_EXAMPLE)
 	TSAN_OPTIONS=halt_on_error=1:exitcode=66 $(TSAN_TEST)
+	TSAN_OPTIONS=halt_on_error=1:exitcode=66 $(TSAN_EXAMPLE)
 
 # A fresh machine: install the dependencies once (the stamp remembers), then every check.
 DEPS_STAMP := $(VENV)/.deps-installed
