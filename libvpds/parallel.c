@@ -95,7 +95,8 @@ static vpds_status tile_deps(const phase_batch *b, uint64_t tile, vpdsi_mem *m, 
                              vpds_tile_points **pts, size_t *nd, size_t *cap)
 {
     size_t i;
-    *cap = VPDS_TILING_MAX_DEPS;
+    int k;
+    for (*cap = 1, k = 0; k < b->t->dim; k++) *cap *= 3; /* the 3^dim offsets, as tiles.c */
     *dep = (uint64_t *)vpdsi_mem_alloc(m, *cap * sizeof **dep);
     *pts = (vpds_tile_points *)vpdsi_mem_alloc(m, *cap * sizeof **pts);
     if (!*dep || !*pts) return VPDS_ERR_OUT_OF_MEMORY;
@@ -194,7 +195,7 @@ static void *work(void *batch)
 static void dispatch(phase_batch *b, int threads, const vpds_tiling_run_desc *d)
 {
     uint64_t i;
-    if (d->executor) {
+    if (d->executor && threads == 0) { /* 1: kept serial (threads_for) */
         d->executor(run_task, b, b->n_tasks, d->executor_user);
         return;
     }

@@ -84,6 +84,13 @@ static void shuffled_executor(vpds_task_fn run, void *batch, uint64_t n, void *u
     free(perm);
 }
 
+static void counting_executor(vpds_task_fn run, void *batch, uint64_t n, void *user)
+{
+    uint64_t i;
+    ++*(uint64_t *)user;
+    for (i = 0; i < n; i++) run(batch, i);
+}
+
 static vpds_tiled *run_with(const vpds_tiling *tg, int threads, vpds_executor_fn ex, void *user,
                             int safe)
 {
@@ -184,10 +191,17 @@ static void check_tiling(int dim, uint64_t tiles_per_axis, double inhibition, in
     a = run_with(tg, 0, shuffled_executor, &state, 1);
     CHECK(same_points(a, ref, n, dim));
     vpds_tiled_destroy(a);
-    /* a callback not declared thread-safe: serial, the same bytes */
+    /* a callback not declared thread-safe: serial, the same bytes, and the executor unused */
     a = run_with(tg, 4, NULL, NULL, 0);
     CHECK(same_points(a, ref, n, dim) && vpds_tiled_threads(a) == (callback ? 1 : 4));
     vpds_tiled_destroy(a);
+    {
+        uint64_t batches = 0;
+        a = run_with(tg, 0, counting_executor, &batches, 0);
+        CHECK(same_points(a, ref, n, dim) && vpds_tiled_threads(a) == (callback ? 1 : 0));
+        CHECK_MSG(callback ? batches == 0 : batches > 0, "%llu batches", (unsigned long long)batches);
+        vpds_tiled_destroy(a);
+    }
     free(ref);
     vpds_tiling_destroy(tg);
 }
