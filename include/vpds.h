@@ -152,7 +152,8 @@ typedef struct vpds_desc {
     uint64_t seed;
     vpds_allocator allocator;
 
-    uint64_t budget;            /* work units (darts + cells) per call before VPDS_PAUSED; 0: none */
+    uint64_t budget;            /* work units per call before VPDS_PAUSED (0: none): a dart, a
+                                   cell, or a box of the coverage search (two radii, domains) */
     vpds_progress_fn progress;  /* called between chunks of work; may pause */
     void *progress_user;
 

@@ -330,6 +330,7 @@ static vpds_status darts_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
     vpdsi_rng start = *ctx->rng;
     vpds_status e;
     size_t j;
+    uint64_t boxes0 = m->unc.boxes;
     if ((e = prepare_darts(m, ctx, n, weighted)) != VPDS_OK) return e;
     for (j = 0; j < n; j++) {
         const double *y = m->buf_x + j * (size_t)ctx->pb->dim;
@@ -343,6 +344,11 @@ static vpds_status darts_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
         if (accept) {
             vpdsi_store_append(st, y, m->buf_r[j], m->run.t, 0);
             ctx->stats->accepted++;
+        }
+        if (j + 1 < n && j + 1 + (m->unc.boxes - boxes0) >= n) {
+            /* the coverage searches spent the chunk's work: stop here, as a pause would */
+            keep_darts_before(m, ctx, &start, j + 1, weighted);
+            return VPDS_OK;
         }
     }
     m->run.darts_left -= n;
@@ -678,12 +684,15 @@ static vpds_status sweep_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, int
         vpdsi_store_error(ctx->st, "out of memory for the active cells of level %u", run->next.level);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
+    uint64_t boxes0 = m->unc.boxes;
     if (need_r && (e = centre_radii(m, ctx, n, cur_level(m))) != VPDS_OK) return e;
     for (j = 0; j < n; j++) {
         cell_coords(m, ctx, run->pos, c);
         if ((e = sweep_cell(m, ctx, c, need_r ? m->buf_r[j] : 0.0, need_r, split)) != VPDS_OK)
             return e;
         run->pos++;
+        /* the coverage searches' boxes are work too: a budget bounds them */
+        if (j + 1 + (m->unc.boxes - boxes0) >= n) break;
     }
     return VPDS_OK;
 }
@@ -776,9 +785,10 @@ static vpds_status sweep_step(vpdsi_mps *m, const vpdsi_ctx *ctx, uint64_t limit
     vpds_status e;
     /* past 8D a cell's 2^d children take the room of 2^(d-8) cells in a chunk */
     if (split && ctx->pb->dim > BLOCK_BITS) limit = (limit >> (ctx->pb->dim - BLOCK_BITS)) + 1;
+    uint64_t boxes0 = m->unc.boxes;
     if (total - run->pos < limit) limit = total - run->pos;
     e = sweep_chunk(m, ctx, (size_t)limit, split);
-    *done = run->pos - before;
+    *done = run->pos - before + (m->unc.boxes - boxes0);
     if (e != VPDS_OK || run->pos != total) return e;
     if (ctx->pb->two_radii) {
         run->vsplit = split | (run->phase == VPDSI_FILTER ? 2 : 0);
@@ -820,9 +830,10 @@ static vpds_status darts_step(vpdsi_mps *m, const vpdsi_ctx *ctx, uint64_t limit
         begin_sweep(m, ctx, cur_level(m) < run->max_level);
         return VPDS_OK;
     }
+    uint64_t boxes0 = m->unc.boxes;
     if (run->darts_left < limit) limit = run->darts_left;
     e = darts_chunk(m, ctx, (size_t)limit);
-    *done = before - run->darts_left;
+    *done = before - run->darts_left + (m->unc.boxes - boxes0);
     return e;
 }
 

@@ -343,6 +343,7 @@ static vpds_status search(bb_search *q, int *found)
             double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
             memcpy(lo, bx, (size_t)d * sizeof(double));
             memcpy(hi, bx + d, (size_t)d * sizeof(double));
+            q->u->boxes++;
             if (++boxes > UNCOVERED_BUDGET) {
                 *found = 1;
                 return VPDS_OK;

@@ -20,6 +20,7 @@ typedef struct vpdsi_uncovered {
     int ready;     /* the tree describes the current cells */
     int32_t *lists; size_t n_lists, cap_lists; /* candidate lists of a search, per depth */
     double *stack; size_t cap_stack;           /* boxes still to examine */
+    uint64_t boxes; /* boxes examined so far: work units of the budget, as darts and cells */
 } vpdsi_uncovered;
 
 void vpdsi_uncovered_init(vpdsi_uncovered *u, int dim, const double *period);
