@@ -238,7 +238,9 @@ VPDS_API vpds_status vpds_estimate(vpds_sampler *sampler, double t, vpds_run_est
 /* Hold at most `bytes` (0: no limit, the default). A run or refinement whose estimate exceeds
  * the limit is refused before it starts (VPDS_ERR_OUT_OF_MEMORY, the estimate in
  * vpds_last_error); past the estimate, an allocation that would exceed the limit fails as the
- * allocator would, and the sampler is left as after any allocation failure. */
+ * allocator would, and the sampler is left as after any allocation failure. With a limit, each
+ * run from a new scale makes that estimate first (4096 sizing and domain calls). A sizing grid's
+ * copy, made at vpds_create, is not counted. */
 VPDS_API vpds_status vpds_set_memory_limit(vpds_sampler *sampler, size_t bytes);
 
 /* ---- Grid sizing: values at the nodes of a regular grid over [lo, hi], multilinear between. */
@@ -426,8 +428,8 @@ typedef struct vpds_tiling_run_desc {
                              calling one and n - 1 the library starts and joins per phase) */
     vpds_executor_fn executor; /* instead of threads: the caller's job system (NULL: none) */
     void *executor_user;
-    int callbacks_thread_safe; /* non-zero: the sizing and domain callbacks may run on several
-                                  threads at once; else a tiling with a callback runs serially */
+    int callbacks_thread_safe; /* non-zero: the sizing, domain and progress callbacks may run on
+                                  several threads at once; else a tiling with one runs serially */
     int allocator_thread_safe; /* non-zero: the tiling's allocator may be called from several
                                   threads at once; else the library calls it under its own lock */
 } vpds_tiling_run_desc;

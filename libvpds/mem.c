@@ -38,6 +38,7 @@ void *vpdsi_mem_alloc(vpdsi_mem *m, size_t size)
     if (size == 0) size = 1;
     if (!within_limit(m, size)) return NULL;
     p = m->a.alloc(size, m->a.user);
+    if (!p) m->limit_hit = 0; /* the last failure is the allocator's own */
     if (p) {
         m->held += size;
         if (m->held > m->peak) m->peak = m->held;
@@ -75,7 +76,10 @@ int vpdsi_mem_reserve(vpdsi_mem *m, void **p, size_t *cap, size_t need, size_t e
     if (*p && m->a.realloc) {
         if (!within_limit(m, new_bytes - old_bytes)) return -1;
         q = m->a.realloc(*p, old_bytes, new_bytes, m->a.user);
-        if (!q) return -1;
+        if (!q) {
+            m->limit_hit = 0;
+            return -1;
+        }
         m->held += new_bytes - old_bytes;
         if (m->held > m->peak) m->peak = m->held;
     } else {

@@ -8,7 +8,7 @@ typedef struct vpdsi_mem {
     size_t held;
     size_t peak;
     size_t limit;   /* most bytes held at once (0: none): past it an allocation fails */
-    int limit_hit;  /* an allocation failed for the limit, not the allocator */
+    int limit_hit;  /* the last failed allocation failed for the limit, not the allocator */
 } vpdsi_mem;
 
 /* Fill a from the user's allocator (both NULL: malloc/free). */

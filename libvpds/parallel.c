@@ -332,6 +332,7 @@ vpds_status vpds_tiling_run(const vpds_tiling *t, const vpds_tiling_run_desc *de
     vpds_allocator wrapped;
     tile_result *res = NULL;
     uint64_t *order = NULL;
+    size_t res_bytes = 0, order_bytes = 0;
     vpds_status st;
     int threads, locked = 0;
     if (msg && cap) msg[0] = 0;
@@ -361,20 +362,25 @@ vpds_status vpds_tiling_run(const vpds_tiling *t, const vpds_tiling_run_desc *de
     }
 #endif
     m = t->mem;
-    res = (tile_result *)vpdsi_mem_alloc(&m, (size_t)t->count * sizeof *res);
-    order = (uint64_t *)vpdsi_mem_alloc(&m, (size_t)t->count * sizeof *order);
-    if (!res || !order) {
+    if ((uint64_t)(size_t)t->count != t->count ||
+        vpdsi_mul_size((size_t)t->count, sizeof *res, &res_bytes) ||
+        vpdsi_mul_size((size_t)t->count, sizeof *order, &order_bytes)) {
+        st = VPDS_ERR_OVERFLOW;
+        if (msg && cap) snprintf(msg, cap, "%llu tiles: their records overflow the address space",
+                                 (unsigned long long)t->count);
+    } else if (!(res = (tile_result *)vpdsi_mem_alloc(&m, res_bytes)) ||
+               !(order = (uint64_t *)vpdsi_mem_alloc(&m, order_bytes))) {
         st = VPDS_ERR_OUT_OF_MEMORY;
         if (msg && cap) snprintf(msg, cap, "out of memory for %llu tiles", (unsigned long long)t->count);
     } else {
-        memset(res, 0, (size_t)t->count * sizeof *res);
+        memset(res, 0, res_bytes);
         b.res = res;
         if ((st = run_phases(&b, order, threads, &d, msg, cap)) == VPDS_OK)
             st = assemble(t, res, order, threads, out, msg, cap);
-        free_results(t, res, b.alloc);
     }
-    if (res) vpdsi_mem_free(&m, res, (size_t)t->count * sizeof *res);
-    if (order) vpdsi_mem_free(&m, order, (size_t)t->count * sizeof *order);
+    if (b.res) free_results(t, b.res, b.alloc); /* set once res is zeroed */
+    if (res) vpdsi_mem_free(&m, res, res_bytes);
+    if (order) vpdsi_mem_free(&m, order, order_bytes);
 #ifdef VPDSI_THREADS
     pthread_mutex_destroy(&b.next_lock);
     if (locked) pthread_mutex_destroy(&lock.lock);
