@@ -7,7 +7,6 @@
 #include "estimate.h"
 #include "rng.h"
 #include <math.h>
-#include <stdio.h>
 #include <string.h>
 
 #define PROBES 4096
@@ -44,43 +43,23 @@ typedef struct probe_sums {
     unsigned inside;
 } probe_sums;
 
-/* The domain at n probes: inside[i] = 1 where sdf <= 0; NaN is VPDS_ERR_DOMAIN. */
-static vpds_status probe_domain(vpdsi_domain *dm, int d, const double *x, size_t n, int *inside,
-                                char *err, size_t cap)
+/* BATCH probes: r and the domain through the store (their errors said in its sink). */
+static vpds_status probe_batch(const vpdsi_problem *pb, vpdsi_store *st, vpdsi_domain *dm,
+                               double t, double ball, vpdsi_rng *rng, probe_sums *sums)
 {
+    double x[BATCH * VPDS_MAX_DIM], r[BATCH], phi[BATCH], root_d = sqrt((double)pb->dim);
+    int d = pb->dim, k;
     size_t i;
-    for (i = 0; i < n; i++) {
-        double phi = 1;
-        inside[i] = 1;
-        if (!dm->fn) continue;
-        phi = dm->fn(x + i * (size_t)d, dm->user);
-        dm->calls++;
-        if (isnan(phi)) {
-            char where[512];
-            vpdsi_format_point(where, sizeof where, x + i * (size_t)d, d);
-            if (cap) snprintf(err, cap, "vpds_estimate: the domain function returned NaN at (%s)", where);
-            return VPDS_ERR_DOMAIN;
-        }
-        inside[i] = phi <= 0;
-    }
-    return VPDS_OK;
-}
-
-static vpds_status probe_batch(const vpdsi_problem *pb, vpdsi_sizing *sz, vpdsi_domain *dm,
-                               double t, vpdsi_rng *rng, probe_sums *sums, char *err, size_t cap)
-{
-    double x[BATCH * VPDS_MAX_DIM], r[BATCH];
-    int inside[BATCH], d = pb->dim, k;
-    double ball = pow(3.14159265358979323846, d / 2.0) / tgamma(d / 2.0 + 1), root_d = sqrt((double)d);
-    size_t i;
-    vpds_status st;
-    for (i = 0; i < BATCH; i++)
+    vpds_status e;
+    for (i = 0; i < BATCH; i++) {
         for (k = 0; k < d; k++)
             x[i * (size_t)d + (size_t)k] = pb->lo[k] + (pb->hi[k] - pb->lo[k]) * vpdsi_rng_unit(rng);
-    if ((st = probe_domain(dm, d, x, BATCH, inside, err, cap)) != VPDS_OK) return st;
-    if ((st = vpdsi_sizing_eval(sz, x, BATCH, r, err, cap)) != VPDS_OK) return st;
+        phi[i] = 0;
+        if (dm->fn && (e = vpdsi_domain_at(dm, st, x + i * (size_t)d, &phi[i])) != VPDS_OK) return e;
+    }
+    if ((e = vpdsi_store_radii(st, x, BATCH, r)) != VPDS_OK) return e;
     for (i = 0; i < BATCH; i++) {
-        if (!inside[i]) continue;
+        if (phi[i] > 0) continue;
         sums->inside++;
         sums->inv_ball += 1 / (ball * pow(0.5 * t * pb->coverage * r[i], d));
         sums->inv_cell += pow(root_d / (t * pb->coverage * r[i]), d);
@@ -101,22 +80,22 @@ static double face_factor(const vpdsi_problem *pb, double inv_cell_sum)
     return factor;
 }
 
-vpds_status vpdsi_estimate_run(const vpdsi_problem *pb, vpdsi_sizing *sz, vpdsi_domain *dm,
-                               double t, size_t fixed_bytes, vpds_run_estimate *out, char *err,
-                               size_t cap)
+vpds_status vpdsi_estimate_run(const vpdsi_problem *pb, vpdsi_store *st, vpdsi_domain *dm,
+                               double t, size_t fixed_bytes, vpds_run_estimate *out)
 {
     probe_sums sums;
     vpdsi_rng rng;
     double volume = 1, side, base, fraction, cells;
+    double ball = pow(3.14159265358979323846, pb->dim / 2.0) / tgamma(pb->dim / 2.0 + 1);
     int d = pb->dim, k, b;
-    vpds_status st;
+    vpds_status e;
     memset(out, 0, sizeof *out);
     memset(&sums, 0, sizeof sums);
     vpdsi_rng_seed(&rng, PROBE_SEED);
     for (b = 0; b < PROBES / BATCH; b++)
-        if ((st = probe_batch(pb, sz, dm, t, &rng, &sums, err, cap)) != VPDS_OK) return st;
+        if ((e = probe_batch(pb, st, dm, t, ball, &rng, &sums)) != VPDS_OK) return e;
     for (k = 0; k < d; k++) volume *= pb->hi[k] - pb->lo[k];
-    side = vpdsi_lattice_base_side(t * pb->coverage * sz->rmax, d);
+    side = vpdsi_lattice_base_side(t * pb->coverage * st->sizing.rmax, d);
     base = vpdsi_lattice_base_count(d, pb->lo, pb->hi, side);
     /* a domain no probe meets still has its straddling cells: count one probe's share */
     fraction = (sums.inside > 0 ? sums.inside : 1) / (double)PROBES;

@@ -95,8 +95,7 @@ static vpds_status tile_deps(const phase_batch *b, uint64_t tile, vpdsi_mem *m, 
                              vpds_tile_points **pts, size_t *nd, size_t *cap)
 {
     size_t i;
-    int k;
-    for (*cap = 1, k = 0; k < b->t->dim; k++) *cap *= 3; /* the 3^dim offsets, as tiles.c */
+    *cap = vpdsi_tiling_codes(b->t->dim);
     *dep = (uint64_t *)vpdsi_mem_alloc(m, *cap * sizeof **dep);
     *pts = (vpds_tile_points *)vpdsi_mem_alloc(m, *cap * sizeof **pts);
     if (!*dep || !*pts) return VPDS_ERR_OUT_OF_MEMORY;

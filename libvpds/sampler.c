@@ -104,8 +104,7 @@ static vpds_status check_memory_limit(vpds_sampler *s, double t)
     vpds_run_estimate e;
     vpds_status st;
     if (s->mem.limit == 0) return VPDS_OK;
-    st = vpdsi_estimate_run(&s->pb, &s->store.sizing, &s->domain, t, sizeof *s, &e, s->store.err,
-                            sizeof s->store.err);
+    st = vpdsi_estimate_run(&s->pb, &s->store, &s->domain, t, sizeof *s, &e);
     if (st != VPDS_OK || !(e.bytes > (double)s->mem.limit)) return st;
     vpdsi_store_error(&s->store, "a maximal run at scale t = %g needs about %.3g bytes (%.3g samples,"
                       " %.3g cells; vpds_estimate), above the memory limit of %zu bytes "
@@ -246,8 +245,7 @@ vpds_status vpds_estimate(vpds_sampler *s, double t, vpds_run_estimate *out)
     }
     s->mem.limit_hit = 0;
     if ((st = ensure_rmax(s)) != VPDS_OK) return vpdsi_sampler_note_limit(s, st);
-    return vpdsi_estimate_run(&s->pb, &s->store.sizing, &s->domain, t, sizeof *s, out, s->store.err,
-                              sizeof s->store.err);
+    return vpdsi_estimate_run(&s->pb, &s->store, &s->domain, t, sizeof *s, out);
 }
 
 vpds_status vpds_set_memory_limit(vpds_sampler *s, size_t bytes)

@@ -273,7 +273,7 @@ vpds_status vpds_tiling_box(const vpds_tiling *t, uint64_t tile, double *lo, dou
     return VPDS_OK;
 }
 
-static unsigned tiles_codes(int dim)
+unsigned vpdsi_tiling_codes(int dim)
 {
     unsigned n = 1;
     int k;
@@ -331,7 +331,7 @@ static size_t tiles_unique(uint64_t *v, size_t n)
 size_t vpdsi_tiling_deps_into(const vpds_tiling *t, uint64_t tile, uint64_t *buf)
 {
     uint64_t c[VPDS_MAX_DIM], nb, nc[VPDS_MAX_DIM];
-    unsigned code, codes = tiles_codes(t->dim);
+    unsigned code, codes = vpdsi_tiling_codes(t->dim);
     int wrap[VPDS_MAX_DIM], phase;
     size_t n = 0;
     tiles_coords_of(t, tile, c);
@@ -351,7 +351,7 @@ vpds_status vpds_tiling_deps(const vpds_tiling *t, uint64_t tile, uint64_t *out,
     size_t count, bytes;
     if (!tiles_live(t) || !n || tile >= t->count || (cap && !out)) return VPDS_ERR_INVALID_ARGUMENT;
     m = t->mem; /* a copy: the tiling itself stays untouched */
-    bytes = (size_t)tiles_codes(t->dim) * sizeof *buf;
+    bytes = (size_t)vpdsi_tiling_codes(t->dim) * sizeof *buf;
     if (!(buf = (uint64_t *)vpdsi_mem_alloc(&m, bytes))) return VPDS_ERR_OUT_OF_MEMORY;
     count = vpdsi_tiling_deps_into(t, tile, buf);
     *n = count;
@@ -388,7 +388,7 @@ vpds_status vpds_tiling_cone(const vpds_tiling *t, uint64_t tile, uint64_t *out,
     size_t i, count;
     if (!tiles_live(t) || !n || tile >= t->count || (cap && !out)) return VPDS_ERR_INVALID_ARGUMENT;
     d = t->dim;
-    codes = tiles_codes(d);
+    codes = vpdsi_tiling_codes(d);
     tiles_coords_of(t, tile, c);
     ph = tiles_phase_of(t, c);
     *n = 0;
@@ -497,7 +497,7 @@ static size_t tiles_gather(const vpds_tiling *t, const uint64_t *c, const uint64
                            const size_t *order, const vpds_tile_points *deps, const double *lo,
                            const double *hi, double *fx, double *fr)
 {
-    unsigned codes = tiles_codes(t->dim), code;
+    unsigned codes = vpdsi_tiling_codes(t->dim), code;
     double m2 = t->margin * t->margin, y[VPDS_MAX_DIM];
     size_t j, i, count = 0;
     int d = t->dim, k, wrap[VPDS_MAX_DIM];
@@ -653,8 +653,8 @@ vpds_status vpdsi_tile_create(const vpds_tiling *t, uint64_t tile, const vpds_ti
     tiles_box_of(t, c, lo, hi);
     m = t->mem;
     if (allocator) vpdsi_mem_init(&m, allocator);
-    dep_bytes = (size_t)tiles_codes(t->dim) * sizeof *dep;
-    order_bytes = (size_t)tiles_codes(t->dim) * sizeof *order;
+    dep_bytes = (size_t)vpdsi_tiling_codes(t->dim) * sizeof *dep;
+    order_bytes = (size_t)vpdsi_tiling_codes(t->dim) * sizeof *order;
     dep = (uint64_t *)vpdsi_mem_alloc(&m, dep_bytes);
     order = (size_t *)vpdsi_mem_alloc(&m, order_bytes);
     if (!dep || !order) {

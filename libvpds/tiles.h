@@ -21,7 +21,10 @@ struct vpds_tiling {
     double lipschitz, rmin, rmax;    /* the whole sizing's, imposed on every tile's sampler */
 };
 
-/* The tiles this tile's run needs, ascending, into buf (3^dim - 1 entries); returns the count. */
+/* 3^dim: the neighbour offsets of a tile (itself included), the room its dependencies need. */
+unsigned vpdsi_tiling_codes(int dim);
+/* The tiles this tile's run needs, ascending, into buf (vpdsi_tiling_codes(dim) entries);
+ * returns the count. */
 size_t vpdsi_tiling_deps_into(const vpds_tiling *t, uint64_t tile, uint64_t *buf);
 /* vpds_tile_create with another allocator for the tile (NULL: the tiling's): a parallel run's
  * lock around the caller's allocator. */
