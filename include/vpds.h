@@ -454,6 +454,75 @@ VPDS_API const uint64_t *vpds_tiled_tiles(const vpds_tiled *tiled);
  * declared thread-safe, or a platform without POSIX threads); with an executor, 0. */
 VPDS_API int vpds_tiled_threads(const vpds_tiled *tiled);
 
+/* ---- Surfaces (libvpds/mesh.c, libvpds/surface.c): maximal Poisson-disk sampling of a triangle
+ * mesh. The sampled set S is the union of the mesh's triangles of positive area; distances are
+ * Euclidean in R^3 and a point y of S conflicts with or is covered by a sample exactly as in the
+ * box case, under each rule (r(y) read at y: interpolated from vertex_radii over y's triangle, or
+ * the sizing at y). A completed run is conflict-free in insertion order and maximal: every point
+ * of every triangle of positive area, edges and corners included, is covered (up to the precision
+ * vpds_stats.delta, 0 when nothing was left). Each sample is uniform by area over the part of S
+ * that is free when it is placed (Algorithm 1: active pieces are sub-triangles split at their
+ * edge midpoints into four of equal area; a dart picks a piece with probability proportional to
+ * its area, then a uniform point of it).
+ * A triangle whose area is below 2^-40 of its longest edge squared is degenerate: it is not part
+ * of S, gets no darts and is not checked for coverage (its points lie on a segment; where that is
+ * another triangle's edge they are covered there). A mesh of degenerate triangles only is refused.
+ * Adding or removing degenerate triangles changes no sample (only the face indices they shift).
+ * With vertex_radii, L is checked per triangle (the gradient of r over it, against the rule's
+ * limit of Table 1); two sheets close in space with different radii are not checked against each
+ * other (conflict and coverage stay exact: r is read at the points themselves). */
+typedef struct vpds_mesh vpds_mesh;
+
+typedef struct vpds_mesh_desc {
+    uint32_t cookie;            /* set by vpds_default_mesh_desc; do not change */
+    uint32_t struct_size;
+    const double *vertices;     /* n_vertices * 3 doubles; copied at create */
+    size_t n_vertices;
+    const uint32_t *triangles;  /* n_triangles * 3 vertex indices; copied at create */
+    size_t n_triangles;
+    double radius;                     /* default 0.05, when no other sizing is set */
+    const double *vertex_radii;        /* n_vertices radii > 0, linear over each triangle (NULL: none) */
+    vpds_sizing_fn sizing;             /* r at a point of R^3 (as vpds_desc.sizing with dim 3) */
+    vpds_sizing_batch_fn sizing_batch;
+    void *sizing_user;
+    const vpds_grid *sizing_grid;      /* a 3D grid, copied at create */
+    double lipschitz;   /* L of the sizing; VPDS_UNSET by default; required with a callback */
+    vpds_rule rule;
+    double inhibition;  /* R_f factor (default 1); this version needs inhibition == coverage */
+    double coverage;    /* R_c factor (default 1) */
+    uint64_t seed;
+    vpds_allocator allocator;
+    uint64_t budget;            /* work units per call before VPDS_PAUSED (0: none): a dart, a piece */
+    vpds_progress_fn progress;  /* called between chunks of work; may pause */
+    void *progress_user;
+    uint32_t algorithm_version; /* 0: current; meshes exist from version 3 on */
+} vpds_mesh_desc;
+
+VPDS_API vpds_mesh_desc vpds_default_mesh_desc(void);
+/* Why a mesh descriptor is refused (the field, and the vertex or triangle), into msg. */
+VPDS_API vpds_status vpds_mesh_validate(const vpds_mesh_desc *desc, char *msg, size_t cap);
+VPDS_API vpds_status vpds_mesh_create(const vpds_mesh_desc *desc, vpds_mesh **out);
+VPDS_API void vpds_mesh_destroy(vpds_mesh *mesh);
+VPDS_API const char *vpds_mesh_last_error(const vpds_mesh *mesh);
+/* Sample to maximal at scale 1 (VPDS_OK), or VPDS_PAUSED by the budget or progress: call again.
+ * An error (out of memory, a bad sizing value) leaves the mesh as a pause would. */
+VPDS_API vpds_status vpds_mesh_run(vpds_mesh *mesh);
+/* Continue a completed run down to the smaller scale t (0 < t < the current one): the samples
+ * kept, new ones added until maximal at t (Section 4.1). */
+VPDS_API vpds_status vpds_mesh_refine(vpds_mesh *mesh, double t);
+VPDS_API vpds_status vpds_mesh_set_budget(vpds_mesh *mesh, uint64_t budget);
+VPDS_API size_t vpds_mesh_count(const vpds_mesh *mesh);
+/* count * 3 coordinates; r; the scale t each sample was placed at. */
+VPDS_API const double *vpds_mesh_points(const vpds_mesh *mesh);
+VPDS_API const double *vpds_mesh_radii(const vpds_mesh *mesh);
+VPDS_API const double *vpds_mesh_scales(const vpds_mesh *mesh);
+/* The triangle of each sample (an index into desc.triangles), and its barycentric coordinates:
+ * count * 3 doubles (b0, b1, b2) summing to 1, for the triangle's vertices in order. */
+VPDS_API const uint32_t *vpds_mesh_faces(const vpds_mesh *mesh);
+VPDS_API const double *vpds_mesh_barycentrics(const vpds_mesh *mesh);
+/* Counters as for a box (active_cells count pieces); maximal when the last run completed. */
+VPDS_API vpds_stats vpds_mesh_get_stats(const vpds_mesh *mesh);
+
 #ifdef __cplusplus
 }
 #endif

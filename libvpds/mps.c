@@ -270,23 +270,6 @@ static vpds_status prepare_darts(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, i
     return VPDS_OK;
 }
 
-/* The dart y of radius ry met sample i whose radius breaks the sizing's L. */
-static vpds_status lipschitz_broken(vpdsi_store *st, const double *y, double ry, int32_t i)
-{
-    char py[256], px[256];
-    const double *x = st->x + (size_t)i * (size_t)st->dim;
-    double dist = 0;
-    int k;
-    for (k = 0; k < st->dim; k++) dist += (y[k] - x[k]) * (y[k] - x[k]);
-    dist = sqrt(dist);
-    vpdsi_format_point(py, sizeof py, y, st->dim);
-    vpdsi_format_point(px, sizeof px, x, st->dim);
-    vpdsi_store_error(st, "sizing breaks lipschitz = %g: r = %.17g at (%s) and r = %.17g at (%s), "
-                      "distance %.17g, slope %.17g", st->sizing.lipschitz, ry, py, st->r[i], px,
-                      dist, fabs(ry - st->r[i]) / dist);
-    return VPDS_ERR_LIPSCHITZ;
-}
-
 /* Whether the dart y (radius ry) becomes a sample (Eq. 4): it conflicts with no sample, lies
  * in the domain and, with two radii, covers a point not yet covered (Section 3.1, first
  * option). */
@@ -306,7 +289,7 @@ static vpds_status judge_dart(vpdsi_mps *m, const vpdsi_ctx *ctx, const double *
         hit = vpdsi_store_conflict(st, y, ry, (int)pb->rule, scale,
                                    varying ? st->sizing.lipschitz : -1.0, &witness);
     }
-    if (hit == -2) return lipschitz_broken(st, y, ry, witness);
+    if (hit == -2) return vpdsi_store_lipschitz_broken(st, y, ry, witness);
     if (hit != -1) return VPDS_OK; /* conflicts with sample hit */
     if (ctx->dom->fn) {
         double phi;

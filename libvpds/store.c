@@ -253,3 +253,20 @@ vpds_status vpdsi_store_add_fixed(vpdsi_store *st, const double *x, const double
     st->n_fixed += n;
     return VPDS_OK;
 }
+
+/* The dart y of radius ry met sample i whose radius breaks the sizing's L. */
+vpds_status vpdsi_store_lipschitz_broken(vpdsi_store *st, const double *y, double ry, int32_t i)
+{
+    char py[256], px[256];
+    const double *x = st->x + (size_t)i * (size_t)st->dim;
+    double dist = 0;
+    int k;
+    for (k = 0; k < st->dim; k++) dist += (y[k] - x[k]) * (y[k] - x[k]);
+    dist = sqrt(dist);
+    vpdsi_format_point(py, sizeof py, y, st->dim);
+    vpdsi_format_point(px, sizeof px, x, st->dim);
+    vpdsi_store_error(st, "sizing breaks lipschitz = %g: r = %.17g at (%s) and r = %.17g at (%s), "
+                      "distance %.17g, slope %.17g", st->sizing.lipschitz, ry, py, st->r[i], px,
+                      dist, fabs(ry - st->r[i]) / dist);
+    return VPDS_ERR_LIPSCHITZ;
+}

@@ -71,6 +71,9 @@ vpds_status vpdsi_store_use_tree(vpdsi_store *st);
  * on failure. The kd-tree takes over from the grid. */
 vpds_status vpdsi_store_add_fixed(vpdsi_store *st, const double *x, const double *r, size_t n);
 vpdsi_kd_samples vpdsi_store_view(const vpdsi_store *st);
+/* The point y of radius ry met sample i (a conflict query's witness) whose radius breaks the
+ * sizing's L: says both points and the slope, returns VPDS_ERR_LIPSCHITZ. */
+vpds_status vpdsi_store_lipschitz_broken(vpdsi_store *st, const double *y, double ry, int32_t i);
 /* Whether a sample not added as a fixed point exists. */
 int vpdsi_store_has_samples(const vpdsi_store *st);
 #endif

@@ -1,0 +1,392 @@
+/* Public entry points for surfaces: the mesh descriptor (defaults, validation naming the vertex
+ * or triangle), the mesh object that owns copies of the arrays, runs, refinement and results.
+ * The algorithm is surface.c's; the sizing and its checks are the box sampler's (vpds_validate
+ * on a 3D descriptor made from the mesh's). */
+#include "grid.h"
+#include "refuse.h"
+#include "rules.h"
+#include "surface.h"
+#include <math.h>
+#include <string.h>
+
+#define VPDSI_MESH_COOKIE 0x56504d31u /* 'VPM1': layout 1 of vpds_mesh_desc */
+#define VPDSI_MESH_MAGIC 0x56504d53u  /* 'VPMS' */
+#define MESH_ALGORITHM_FIRST 3        /* meshes came with algorithm version 3 */
+/* a triangle below this area per longest edge squared is degenerate (height < 2^-39 length) */
+#define DEGENERATE_AREA 9.094947017729282e-13 /* 2^-40 */
+#define MESH_PRECISION_BITS 44                     /* as the box: no piece splits below 2^-44 of |x| */
+
+struct vpds_mesh {
+    uint32_t magic;
+    vpdsi_mem mem;
+    double *v, *vr, *area, *longest;
+    uint32_t *tri, *live;
+    size_t n_v, n_tri;
+    vpdsi_trimesh view;
+    vpdsi_store store;
+    vpdsi_surface surface;
+    vpdsi_rng rng;
+    vpds_stats stats;
+    vpds_rule rule;
+    double coverage;
+    uint64_t budget;
+    vpds_progress_fn progress;
+    void *progress_user;
+};
+
+vpds_mesh_desc vpds_default_mesh_desc(void)
+{
+    vpds_mesh_desc d;
+    memset(&d, 0, sizeof d);
+    d.cookie = VPDSI_MESH_COOKIE;
+    d.struct_size = (uint32_t)sizeof d;
+    d.radius = 0.05;
+    d.lipschitz = VPDS_UNSET;
+    d.rule = VPDS_RULE_DEFAULT;
+    d.inhibition = 1.0;
+    d.coverage = 1.0;
+    return d;
+}
+
+/* The box sampler's descriptor for the mesh's sizing (3D), which vpds_validate checks and
+ * vpdsi_sizing_from_desc reads. */
+static vpds_desc sizing_desc(const vpds_mesh_desc *d)
+{
+    vpds_desc b = vpds_default_desc();
+    b.dim = 3;
+    if (!d->vertex_radii) b.radius = d->radius;
+    b.sizing = d->sizing;
+    b.sizing_batch = d->sizing_batch;
+    b.sizing_user = d->sizing_user;
+    b.sizing_grid = d->sizing_grid;
+    b.lipschitz = d->lipschitz;
+    b.rule = d->rule;
+    b.inhibition = d->inhibition;
+    b.coverage = d->coverage;
+    b.allocator = d->allocator;
+    return b;
+}
+
+/* Area and longest edge of triangle t. */
+static void triangle_shape(const double *v, const uint32_t *t, double *area, double *longest)
+{
+    const double *a = v + 3 * (size_t)t[0], *b = v + 3 * (size_t)t[1], *c = v + 3 * (size_t)t[2];
+    double e1[3], e2[3], e3[3], cr[3], l1 = 0, l2 = 0, l3 = 0;
+    int k;
+    for (k = 0; k < 3; k++) {
+        e1[k] = b[k] - a[k];
+        e2[k] = c[k] - a[k];
+        e3[k] = c[k] - b[k];
+        l1 += e1[k] * e1[k];
+        l2 += e2[k] * e2[k];
+        l3 += e3[k] * e3[k];
+    }
+    cr[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    cr[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    cr[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    *area = 0.5 * sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+    *longest = sqrt(l1 > l2 ? (l1 > l3 ? l1 : l3) : (l2 > l3 ? l2 : l3));
+}
+
+static int degenerate(double area, double longest)
+{
+    return !(longest > 0) || !(area > DEGENERATE_AREA * longest * longest);
+}
+
+/* |grad r| of the vertex radii over triangle t (of area > 0): r linear in the triangle's plane,
+ * |g|^2 = dr^T G^-1 dr with G the Gram matrix of two edges, det G = 4 area^2. */
+static double radius_slope(const double *v, const double *vr, const uint32_t *t, double area)
+{
+    const double *a = v + 3 * (size_t)t[0], *b = v + 3 * (size_t)t[1], *c = v + 3 * (size_t)t[2];
+    double g11 = 0, g12 = 0, g22 = 0, d1 = vr[t[1]] - vr[t[0]], d2 = vr[t[2]] - vr[t[0]], q;
+    int k;
+    for (k = 0; k < 3; k++) {
+        double e1 = b[k] - a[k], e2 = c[k] - a[k];
+        g11 += e1 * e1;
+        g12 += e1 * e2;
+        g22 += e2 * e2;
+    }
+    q = (d1 * d1 * g22 - 2 * d1 * d2 * g12 + d2 * d2 * g11) / (4 * area * area);
+    return q > 0 ? sqrt(q) : 0;
+}
+
+static vpds_status validate_arrays(const vpds_mesh_desc *d, char *msg, size_t cap)
+{
+    size_t i, n_live = 0;
+    int k;
+    if (!d->vertices || d->n_vertices == 0)
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.vertices: no vertices (n_vertices = %zu)", d->n_vertices);
+    if (!d->triangles || d->n_triangles == 0)
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.triangles: a mesh needs at least one triangle "
+                     "(n_triangles = %zu)", d->n_triangles);
+    if (d->n_vertices > SIZE_MAX / 24 || d->n_triangles > (size_t)UINT32_MAX)
+        VPDSI_REFUSE(VPDS_ERR_OVERFLOW, "desc: %zu vertices, %zu triangles: at most %u triangles, and "
+                     "the arrays' sizes must not overflow", d->n_vertices, d->n_triangles, UINT32_MAX);
+    for (i = 0; i < d->n_vertices; i++)
+        for (k = 0; k < 3; k++) {
+            double x = d->vertices[3 * i + (size_t)k];
+            if (!isfinite(x) || fabs(x) > VPDSI_MAGNITUDE_MAX)
+                VPDSI_REFUSE(isfinite(x) ? VPDS_ERR_OVERFLOW : VPDS_ERR_INVALID_ARGUMENT,
+                             "desc.vertices: vertex %zu coordinate %d = %g: must be finite, within "
+                             "1e150 in magnitude", i, k, x);
+        }
+    if (d->vertex_radii)
+        for (i = 0; i < d->n_vertices; i++)
+            if (!vpdsi_radius_ok(d->vertex_radii[i]))
+                VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.vertex_radii[%zu] = %g: must be within "
+                             "[1e-100, 1e100] (> 0)", i, d->vertex_radii[i]);
+    for (i = 0; i < d->n_triangles; i++) {
+        const uint32_t *t = d->triangles + 3 * i;
+        double area, longest;
+        for (k = 0; k < 3; k++)
+            if (t[k] >= d->n_vertices)
+                VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.triangles: triangle %zu corner %d is vertex %u, "
+                             "out of range (n_vertices = %zu)", i, k, (unsigned)t[k], d->n_vertices);
+        triangle_shape(d->vertices, t, &area, &longest);
+        if (!isfinite(area) || !isfinite(longest))
+            VPDSI_REFUSE(VPDS_ERR_OVERFLOW, "desc.triangles: triangle %zu: its area or edges overflow", i);
+        if (degenerate(area, longest)) continue;
+        n_live++;
+        if (d->vertex_radii) {
+            double L = radius_slope(d->vertices, d->vertex_radii, t, area) * d->coverage;
+            double limit = vpdsi_rule_max_lipschitz(vpdsi_rule_resolve(d->rule));
+            if (!(L < limit))
+                VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.vertex_radii: over triangle %zu r changes with "
+                             "slope coverage * |grad r| = %g, at or above the %s rule's limit %g (Table 1)",
+                             i, L, vpdsi_rule_name(vpdsi_rule_resolve(d->rule)), limit);
+        }
+    }
+    if (n_live == 0)
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.triangles: all %zu triangles are degenerate (area "
+                     "below 2^-40 of the longest edge squared): nothing to sample", d->n_triangles);
+    return VPDS_OK;
+}
+
+vpds_status vpds_mesh_validate(const vpds_mesh_desc *d, char *msg, size_t cap)
+{
+    vpds_desc b;
+    vpds_status e;
+    if (msg && cap) msg[0] = 0;
+    if (!d) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc is NULL");
+    if (d->cookie != VPDSI_MESH_COOKIE)
+        VPDSI_REFUSE(VPDS_ERR_BAD_DESCRIPTOR, "desc.cookie = 0x%08x: the descriptor did not come from "
+                     "vpds_default_mesh_desc()", (unsigned)d->cookie);
+    if (d->struct_size != sizeof *d)
+        VPDSI_REFUSE(VPDS_ERR_BAD_DESCRIPTOR, "desc.struct_size = %u: a layout this library cannot read "
+                     "(it reads %u; rebuild against this vpds.h)", (unsigned)d->struct_size,
+                     (unsigned)sizeof *d);
+    if (d->algorithm_version && (d->algorithm_version < MESH_ALGORITHM_FIRST ||
+                                 d->algorithm_version > VPDS_ALGORITHM_VERSION))
+        VPDSI_REFUSE(VPDS_ERR_UNSUPPORTED, "desc.algorithm_version = %u: meshes have versions %d..%d",
+                     (unsigned)d->algorithm_version, MESH_ALGORITHM_FIRST, VPDS_ALGORITHM_VERSION);
+    if (d->vertex_radii && (d->sizing || d->sizing_batch || d->sizing_grid))
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.vertex_radii and a sizing (sizing, sizing_batch or "
+                     "sizing_grid) are both set: give one");
+    if (d->sizing_grid && d->sizing_grid->magic == VPDSI_GRID_COOKIE && d->sizing_grid->dim != 3)
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.sizing_grid has dim %d: a mesh needs a 3D grid",
+                     d->sizing_grid->dim);
+    b = sizing_desc(d);
+    if ((e = vpds_validate(&b, msg, cap)) != VPDS_OK) return e;
+    if (d->inhibition != d->coverage)
+        VPDSI_REFUSE(VPDS_ERR_UNSUPPORTED, "desc.inhibition = %g, desc.coverage = %g: two radii on a mesh "
+                     "are not in this version (set them equal)", d->inhibition, d->coverage);
+    return validate_arrays(d, msg, cap);
+}
+
+static void *copy_array(vpdsi_mem *m, const void *src, size_t bytes)
+{
+    void *p = vpdsi_mem_alloc(m, bytes);
+    if (p && src) memcpy(p, src, bytes);
+    return p;
+}
+
+static void free_arrays(vpds_mesh *s)
+{
+    vpdsi_mem *m = &s->mem;
+    vpdsi_mem_free(m, s->v, s->n_v * 3 * sizeof(double));
+    vpdsi_mem_free(m, s->vr, s->n_v * sizeof(double));
+    vpdsi_mem_free(m, s->tri, s->n_tri * 3 * sizeof(uint32_t));
+    vpdsi_mem_free(m, s->live, s->n_tri * sizeof(uint32_t));
+    vpdsi_mem_free(m, s->area, s->n_tri * sizeof(double));
+    vpdsi_mem_free(m, s->longest, s->n_tri * sizeof(double));
+}
+
+/* The copies, the live triangles with their shapes, and the bounding box of the vertices. */
+static vpds_status take_arrays(vpds_mesh *s, const vpds_mesh_desc *d, double *lo, double *hi)
+{
+    vpdsi_mem *m = &s->mem;
+    size_t i, n = 0;
+    double mag = 0;
+    int k;
+    s->n_v = d->n_vertices;
+    s->n_tri = d->n_triangles;
+    s->v = (double *)copy_array(m, d->vertices, s->n_v * 3 * sizeof(double));
+    s->vr = d->vertex_radii ? (double *)copy_array(m, d->vertex_radii, s->n_v * sizeof(double)) : NULL;
+    s->tri = (uint32_t *)copy_array(m, d->triangles, s->n_tri * 3 * sizeof(uint32_t));
+    s->live = (uint32_t *)copy_array(m, NULL, s->n_tri * sizeof(uint32_t));
+    s->area = (double *)copy_array(m, NULL, s->n_tri * sizeof(double));
+    s->longest = (double *)copy_array(m, NULL, s->n_tri * sizeof(double));
+    if (!s->v || (d->vertex_radii && !s->vr) || !s->tri || !s->live || !s->area || !s->longest) {
+        free_arrays(s);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < s->n_tri; i++) {
+        double area, longest;
+        triangle_shape(s->v, s->tri + 3 * i, &area, &longest);
+        if (degenerate(area, longest)) continue;
+        s->live[n] = (uint32_t)i;
+        s->area[n] = area;
+        s->longest[n++] = longest;
+    }
+    for (k = 0; k < 3; k++) lo[k] = hi[k] = s->v[k];
+    for (i = 0; i < s->n_v; i++)
+        for (k = 0; k < 3; k++) {
+            double x = s->v[3 * i + (size_t)k];
+            if (x < lo[k]) lo[k] = x;
+            if (x > hi[k]) hi[k] = x;
+            if (fabs(x) > mag) mag = fabs(x);
+        }
+    s->view.v = s->v;
+    s->view.tri = s->tri;
+    s->view.vr = s->vr;
+    s->view.live = s->live;
+    s->view.area = s->area;
+    s->view.longest = s->longest;
+    s->view.n_live = n;
+    s->view.min_edge = ldexp(mag, -MESH_PRECISION_BITS);
+    return VPDS_OK;
+}
+
+vpds_status vpds_mesh_create(const vpds_mesh_desc *d, vpds_mesh **out)
+{
+    vpdsi_mem m;
+    vpds_mesh *s;
+    vpds_desc b;
+    vpds_status e;
+    double lo[3], hi[3];
+    if (!out) return VPDS_ERR_INVALID_ARGUMENT;
+    *out = NULL;
+    if ((e = vpds_mesh_validate(d, NULL, 0)) != VPDS_OK) return e;
+    vpdsi_mem_init(&m, &d->allocator);
+    if (!(s = (vpds_mesh *)vpdsi_mem_alloc(&m, sizeof *s))) return VPDS_ERR_OUT_OF_MEMORY;
+    memset(s, 0, sizeof *s);
+    s->mem = m;
+    if ((e = take_arrays(s, d, lo, hi)) != VPDS_OK) {
+        m = s->mem;
+        vpdsi_mem_free(&m, s, sizeof *s);
+        return e;
+    }
+    vpdsi_store_init(&s->store, &s->mem, 3, lo, hi, NULL);
+    b = sizing_desc(d);
+    if ((e = vpdsi_sizing_from_desc(&s->store.sizing, &b)) != VPDS_OK) {
+        free_arrays(s);
+        m = s->mem;
+        vpdsi_mem_free(&m, s, sizeof *s);
+        return e;
+    }
+    s->rule = vpdsi_rule_resolve(d->rule);
+    s->coverage = d->coverage;
+    s->budget = d->budget;
+    s->progress = d->progress;
+    s->progress_user = d->progress_user;
+    vpdsi_rng_seed(&s->rng, d->seed);
+    vpdsi_surface_init(&s->surface);
+    s->magic = VPDSI_MESH_MAGIC;
+    *out = s;
+    return VPDS_OK;
+}
+
+static int live(const vpds_mesh *s) { return s && s->magic == VPDSI_MESH_MAGIC; }
+
+void vpds_mesh_destroy(vpds_mesh *s)
+{
+    vpdsi_mem m;
+    if (!live(s)) return;
+    vpdsi_surface_release(&s->surface, &s->mem);
+    vpdsi_store_release(&s->store);
+    free_arrays(s);
+    m = s->mem;
+    s->magic = 0;
+    vpdsi_mem_free(&m, s, sizeof *s);
+}
+
+const char *vpds_mesh_last_error(const vpds_mesh *s)
+{
+    if (!s) return "mesh is NULL";
+    if (!live(s)) return "not a live vpds_mesh (destroyed or never created)";
+    return s->store.err;
+}
+
+static vpds_status mesh_work(vpds_mesh *s)
+{
+    vpdsi_surface_ctx c;
+    c.mesh = &s->view;
+    c.st = &s->store;
+    c.rng = &s->rng;
+    c.stats = &s->stats;
+    c.rule = s->rule;
+    c.coverage = s->coverage;
+    c.budget = s->budget;
+    c.progress = s->progress;
+    c.progress_user = s->progress_user;
+    s->store.err[0] = 0;
+    return vpdsi_surface_run(&s->surface, &c);
+}
+
+vpds_status vpds_mesh_run(vpds_mesh *s)
+{
+    if (!live(s)) return VPDS_ERR_INVALID_ARGUMENT;
+    if (s->surface.phase == VPDSI_SURF_IDLE) vpdsi_surface_begin(&s->surface, 1.0);
+    return mesh_work(s);
+}
+
+vpds_status vpds_mesh_refine(vpds_mesh *s, double t)
+{
+    if (!live(s)) return VPDS_ERR_INVALID_ARGUMENT;
+    if (s->surface.phase != VPDSI_SURF_IDLE && t == s->surface.t) return mesh_work(s);
+    if (!isfinite(t) || !vpdsi_scale_ok(t * s->coverage)) {
+        vpdsi_store_error(&s->store, "t = %g: must be finite, > 0, with t * coverage within [1e-50, 1e50]", t);
+        return VPDS_ERR_INVALID_ARGUMENT;
+    }
+    if (s->surface.phase != VPDSI_SURF_IDLE && s->surface.phase != VPDSI_SURF_DONE) {
+        vpdsi_store_error(&s->store, "refine to t = %g: the run at t = %g is not complete (call it "
+                          "again until VPDS_OK first)", t, s->surface.t);
+        return VPDS_ERR_STATE;
+    }
+    if (s->surface.phase == VPDSI_SURF_DONE && !(t < s->surface.t)) {
+        vpdsi_store_error(&s->store, "refine to t = %g: must be below the current scale %g", t, s->surface.t);
+        return VPDS_ERR_INVALID_ARGUMENT;
+    }
+    vpdsi_surface_begin(&s->surface, t);
+    return mesh_work(s);
+}
+
+vpds_status vpds_mesh_set_budget(vpds_mesh *s, uint64_t budget)
+{
+    if (!live(s)) return VPDS_ERR_INVALID_ARGUMENT;
+    s->budget = budget;
+    return VPDS_OK;
+}
+
+size_t vpds_mesh_count(const vpds_mesh *s) { return live(s) ? s->store.n : 0; }
+const double *vpds_mesh_points(const vpds_mesh *s) { return live(s) ? s->store.x : NULL; }
+const double *vpds_mesh_radii(const vpds_mesh *s) { return live(s) ? s->store.r : NULL; }
+const double *vpds_mesh_scales(const vpds_mesh *s) { return live(s) ? s->store.t : NULL; }
+const uint32_t *vpds_mesh_faces(const vpds_mesh *s) { return live(s) ? s->surface.face : NULL; }
+const double *vpds_mesh_barycentrics(const vpds_mesh *s) { return live(s) ? s->surface.bary : NULL; }
+
+vpds_stats vpds_mesh_get_stats(const vpds_mesh *s)
+{
+    vpds_stats st;
+    if (!live(s)) {
+        memset(&st, 0, sizeof st);
+        return st;
+    }
+    st = s->stats;
+    st.bytes_held = s->mem.held;
+    st.peak_bytes = s->mem.peak;
+    st.sizing_calls = s->store.sizing.calls;
+    st.t = s->surface.t;
+    st.maximal = s->surface.phase == VPDSI_SURF_DONE;
+    return st;
+}

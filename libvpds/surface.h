@@ -1,0 +1,74 @@
+/* Algorithm 1 on a triangle mesh: active pieces are sub-triangles of the lattice that midpoint
+ * subdivision makes (each split gives four similar children of equal area), darts land uniform
+ * by area over the active pieces, and a piece is dropped once one sample covers its three
+ * corners (a ball is convex). Samples go to the store (3D, kd-tree); the surface keeps each
+ * sample's triangle and barycentric coordinates beside it. */
+#ifndef VPDS_SURFACE_H
+#define VPDS_SURFACE_H
+#include "rng.h"
+#include "store.h"
+
+/* The mesh as the algorithm reads it (owned by the entry point): only the triangles of positive
+ * area, "live", take part. */
+typedef struct vpdsi_trimesh {
+    const double *v;          /* vertices, 3 doubles each */
+    const uint32_t *tri;      /* 3 vertex indices per triangle */
+    const double *vr;         /* per-vertex radii (NULL: the store's sizing) */
+    const uint32_t *live;     /* the triangles with area, ascending */
+    const double *area;       /* per live triangle */
+    const double *longest;    /* per live triangle: its longest edge */
+    size_t n_live;
+    double min_edge;          /* 2^-44 of the coordinates' magnitude: no piece splits below */
+} vpdsi_trimesh;
+
+/* A piece: lattice triangle (i, j) of triangle live[tri] split `level` times, pointing up
+ * (corners (i,j), (i+1,j), (i,j+1) in units of 2^-level along its two edges) or down (corners
+ * (i+1,j), (i,j+1), (i+1,j+1)). */
+typedef struct vpdsi_piece {
+    uint64_t i, j;
+    uint32_t tri;
+    uint8_t level, down;
+    uint16_t pad;
+} vpdsi_piece;
+
+typedef enum {
+    VPDSI_SURF_IDLE, VPDSI_SURF_SEED, VPDSI_SURF_FILTER, VPDSI_SURF_DARTS, VPDSI_SURF_SWEEP,
+    VPDSI_SURF_DONE
+} vpdsi_surf_phase;
+
+typedef struct vpdsi_surface {
+    vpdsi_surf_phase phase;
+    double t;                            /* scale being sampled */
+    vpdsi_piece *cur, *next;             /* active pieces, and those of the next level */
+    size_t n_cur, cap_cur, n_next, cap_next;
+    double *cum;  size_t cap_cum;        /* running sums of the active pieces' areas */
+    int cum_ready;                       /* cum holds this level's sums */
+    int seed_checked;                    /* the seed count was found within bounds */
+    size_t pos;                          /* seed: next live triangle; sweeps: next piece */
+    uint64_t darts_left;
+    int split_any;                       /* the sweep split a piece (else the run ends) */
+    int32_t *near; size_t n_near, cap_near;
+    uint32_t *face; size_t cap_face;     /* per sample: its triangle (index into tri) */
+    double *bary; size_t cap_bary;       /* per sample: 3 barycentric coordinates */
+} vpdsi_surface;
+
+/* What one call may do, and the problem's constants. */
+typedef struct vpdsi_surface_ctx {
+    const vpdsi_trimesh *mesh;
+    vpdsi_store *st;
+    vpdsi_rng *rng;
+    vpds_stats *stats;
+    vpds_rule rule;           /* resolved */
+    double coverage;          /* = inhibition */
+    uint64_t budget;
+    vpds_progress_fn progress;
+    void *progress_user;
+} vpdsi_surface_ctx;
+
+void vpdsi_surface_init(vpdsi_surface *s);
+void vpdsi_surface_release(vpdsi_surface *s, vpdsi_mem *m);
+/* Start sampling at scale t (the store may hold samples of larger scales). */
+void vpdsi_surface_begin(vpdsi_surface *s, double t);
+/* Work until maximal at s->t (VPDS_OK), paused (VPDS_PAUSED) or failed (the state as a pause). */
+vpds_status vpdsi_surface_run(vpdsi_surface *s, const vpdsi_surface_ctx *ctx);
+#endif

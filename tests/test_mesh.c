@@ -1,0 +1,834 @@
+/* Surfaces (vpds_mesh_*), checked by brute force independent of the library: every sample on its
+ * triangle, no pair in conflict, every probe of a dense set on every triangle (edges and corners
+ * included) covered; determinism, pauses, allocation failure, bad input, degenerate triangles,
+ * and bias-freeness against a box run on a flat square triangulated in several ways. */
+#include "check.h"
+#include "vpds.h"
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+static int quick; /* VPDS_TEST_QUICK (valgrind): smaller meshes, fewer seeds */
+
+typedef struct {
+    double *v;
+    uint32_t *t;
+    size_t nv, nt, cap_v, cap_t;
+} mesh_t;
+
+static void mesh_free(mesh_t *m)
+{
+    free(m->v);
+    free(m->t);
+    memset(m, 0, sizeof *m);
+}
+
+static uint32_t add_v(mesh_t *m, double x, double y, double z)
+{
+    if (m->nv == m->cap_v) {
+        m->cap_v = m->cap_v ? 2 * m->cap_v : 64;
+        m->v = (double *)realloc(m->v, m->cap_v * 3 * sizeof(double));
+    }
+    m->v[3 * m->nv] = x;
+    m->v[3 * m->nv + 1] = y;
+    m->v[3 * m->nv + 2] = z;
+    return (uint32_t)m->nv++;
+}
+
+static void add_t(mesh_t *m, uint32_t a, uint32_t b, uint32_t c)
+{
+    if (m->nt == m->cap_t) {
+        m->cap_t = m->cap_t ? 2 * m->cap_t : 64;
+        m->t = (uint32_t *)realloc(m->t, m->cap_t * 3 * sizeof(uint32_t));
+    }
+    m->t[3 * m->nt] = a;
+    m->t[3 * m->nt + 1] = b;
+    m->t[3 * m->nt + 2] = c;
+    m->nt++;
+}
+
+/* An icosahedron whose faces are split into k*k triangles, pushed onto the unit sphere. */
+static mesh_t icosphere(int k)
+{
+    static const int f[20][3] = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9},
+                                 {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2},
+                                 {3, 2, 6}, {3, 6, 8}, {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10},
+                                 {8, 6, 7}, {9, 8, 1}};
+    double p = (1 + sqrt(5.0)) / 2, ico[12][3] = {{-1, p, 0}, {1, p, 0}, {-1, -p, 0}, {1, -p, 0},
+                                                  {0, -1, p}, {0, 1, p}, {0, -1, -p}, {0, 1, -p},
+                                                  {p, 0, -1}, {p, 0, 1}, {-p, 0, -1}, {-p, 0, 1}};
+    mesh_t m = {0};
+    int fi, a, b;
+    for (fi = 0; fi < 20; fi++) {
+        uint32_t idx[64][64];
+        const double *A = ico[f[fi][0]], *B = ico[f[fi][1]], *C = ico[f[fi][2]];
+        for (a = 0; a <= k; a++)
+            for (b = 0; a + b <= k; b++) {
+                double u = (double)a / k, w = (double)b / k, q[3], n = 0;
+                int c;
+                for (c = 0; c < 3; c++) {
+                    q[c] = A[c] + u * (B[c] - A[c]) + w * (C[c] - A[c]);
+                    n += q[c] * q[c];
+                }
+                n = sqrt(n);
+                idx[a][b] = add_v(&m, q[0] / n, q[1] / n, q[2] / n);
+            }
+        for (a = 0; a < k; a++)
+            for (b = 0; a + b < k; b++) {
+                add_t(&m, idx[a][b], idx[a + 1][b], idx[a][b + 1]);
+                if (a + b + 1 < k) add_t(&m, idx[a + 1][b], idx[a + 1][b + 1], idx[a][b + 1]);
+            }
+    }
+    return m;
+}
+
+/* A torus of radii R and rr, nu x nv quads split in two. */
+static mesh_t torus(double R, double rr, int nu, int nv)
+{
+    mesh_t m = {0};
+    int i, j;
+    for (i = 0; i < nu; i++)
+        for (j = 0; j < nv; j++) {
+            double u = 2 * 3.14159265358979323846 * i / nu, w = 2 * 3.14159265358979323846 * j / nv;
+            add_v(&m, (R + rr * cos(w)) * cos(u), (R + rr * cos(w)) * sin(u), rr * sin(w));
+        }
+    for (i = 0; i < nu; i++)
+        for (j = 0; j < nv; j++) {
+            uint32_t a = (uint32_t)(i * nv + j), b = (uint32_t)(((i + 1) % nu) * nv + j);
+            uint32_t c = (uint32_t)(i * nv + (j + 1) % nv), d = (uint32_t)(((i + 1) % nu) * nv + (j + 1) % nv);
+            add_t(&m, a, b, d);
+            add_t(&m, a, d, c);
+        }
+    return m;
+}
+
+/* The unit square in the plane z = z0, as a grid of n x n cells over [x0, x1] x [0, 1] with
+ * interior vertices jittered (irregular), diagonals alternating. */
+static void square_part(mesh_t *m, double x0, double x1, int nx, int ny, double z0, double jitter,
+                        uint64_t seed)
+{
+    uint32_t base = (uint32_t)m->nv;
+    int i, j;
+    for (j = 0; j <= ny; j++)
+        for (i = 0; i <= nx; i++) {
+            double x = x0 + (x1 - x0) * i / nx, y = (double)j / ny;
+            if (i > 0 && i < nx && j > 0 && j < ny) {
+                seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+                x += jitter * (x1 - x0) / nx * ((double)(seed >> 11) / 9007199254740992.0 - 0.5);
+                seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+                y += jitter / ny * ((double)(seed >> 11) / 9007199254740992.0 - 0.5);
+            }
+            add_v(m, x, y, z0);
+        }
+    for (j = 0; j < ny; j++)
+        for (i = 0; i < nx; i++) {
+            uint32_t a = base + (uint32_t)(j * (nx + 1) + i), b = a + 1;
+            uint32_t c = a + (uint32_t)(nx + 1), d = c + 1;
+            if ((i + j) & 1) {
+                add_t(m, a, b, d);
+                add_t(m, a, d, c);
+            } else {
+                add_t(m, a, b, c);
+                add_t(m, b, d, c);
+            }
+        }
+}
+
+/* ---- the brute-force checks ---- */
+
+static double rule_f(vpds_rule rule, double rx, double ry)
+{
+    switch (rule) {
+    case VPDS_RULE_PRIOR: return rx;
+    case VPDS_RULE_CURRENT: return ry;
+    case VPDS_RULE_BIGGER: return rx > ry ? rx : ry;
+    default: return rx < ry ? rx : ry;
+    }
+}
+
+typedef double (*radius_fn)(const mesh_t *m, const double *vr, uint32_t tri, const double *bary,
+                            const double *x);
+
+static double r_const_val;
+static double r_const(const mesh_t *m, const double *vr, uint32_t tri, const double *b, const double *x)
+{
+    (void)m; (void)vr; (void)tri; (void)b; (void)x;
+    return r_const_val;
+}
+
+static double r_vertex(const mesh_t *m, const double *vr, uint32_t tri, const double *b, const double *x)
+{
+    const uint32_t *t = m->t + 3 * (size_t)tri;
+    (void)x;
+    return b[0] * vr[t[0]] + b[1] * vr[t[1]] + b[2] * vr[t[2]];
+}
+
+static double sizing_z(const double *x, void *u)
+{
+    (void)u;
+    return 0.06 + 0.02 * x[2];
+}
+
+static double r_sizing(const mesh_t *m, const double *vr, uint32_t tri, const double *b, const double *x)
+{
+    (void)m; (void)vr; (void)tri; (void)b;
+    return sizing_z(x, NULL);
+}
+
+/* Samples bucketed in a uniform grid of cell h, for neighbour searches of reach <= h. */
+typedef struct {
+    double lo[3], h;
+    long n[3];
+    size_t *start, *idx;
+} bucket_t;
+
+static long cell_of(const bucket_t *g, const double *x, int k)
+{
+    long c = (long)floor((x[k] - g->lo[k]) / g->h);
+    return c < 0 ? 0 : c >= g->n[k] ? g->n[k] - 1 : c;
+}
+
+static void bucket_build(bucket_t *g, const double *x, size_t n, const mesh_t *m, double h)
+{
+    size_t i, cells, *fill;
+    int k;
+    double hi[3];
+    for (k = 0; k < 3; k++) g->lo[k] = hi[k] = m->v[k];
+    for (i = 0; i < m->nv; i++)
+        for (k = 0; k < 3; k++) {
+            if (m->v[3 * i + k] < g->lo[k]) g->lo[k] = m->v[3 * i + k];
+            if (m->v[3 * i + k] > hi[k]) hi[k] = m->v[3 * i + k];
+        }
+    g->h = h;
+    for (k = 0; k < 3; k++) {
+        g->n[k] = (long)((hi[k] - g->lo[k]) / h) + 1;
+        if (g->n[k] > 200) g->n[k] = 200, g->h = fmax(g->h, (hi[k] - g->lo[k]) / 199.0);
+    }
+    for (k = 0; k < 3; k++) g->n[k] = (long)((hi[k] - g->lo[k]) / g->h) + 1;
+    cells = (size_t)(g->n[0] * g->n[1] * g->n[2]);
+    g->start = (size_t *)calloc(cells + 1, sizeof(size_t));
+    g->idx = (size_t *)malloc((n ? n : 1) * sizeof(size_t));
+    fill = (size_t *)calloc(cells + 1, sizeof(size_t));
+    for (i = 0; i < n; i++) {
+        const double *p = x + 3 * i;
+        g->start[(cell_of(g, p, 0) * g->n[1] + cell_of(g, p, 1)) * g->n[2] + cell_of(g, p, 2) + 1]++;
+    }
+    for (i = 0; i < cells; i++) g->start[i + 1] += g->start[i];
+    for (i = 0; i < n; i++) {
+        const double *p = x + 3 * i;
+        size_t c = (size_t)((cell_of(g, p, 0) * g->n[1] + cell_of(g, p, 1)) * g->n[2] + cell_of(g, p, 2));
+        g->idx[g->start[c] + fill[c]++] = i;
+    }
+    free(fill);
+}
+
+static void bucket_free(bucket_t *g)
+{
+    free(g->start);
+    free(g->idx);
+}
+
+/* Whether some sample covers y (radius ry) at scale t; *conflicts counts samples j < before
+ * (before = SIZE_MAX: none) closer than t * f. */
+static int covered_by_some(const bucket_t *g, const double *x, const double *r, const double *y,
+                           double ry, vpds_rule rule, double t)
+{
+    long c[3], a, b, e;
+    int k;
+    for (k = 0; k < 3; k++) c[k] = cell_of(g, y, k);
+    for (a = c[0] - 1; a <= c[0] + 1; a++)
+        for (b = c[1] - 1; b <= c[1] + 1; b++)
+            for (e = c[2] - 1; e <= c[2] + 1; e++) {
+                size_t cell, q;
+                if (a < 0 || b < 0 || e < 0 || a >= g->n[0] || b >= g->n[1] || e >= g->n[2]) continue;
+                cell = (size_t)((a * g->n[1] + b) * g->n[2] + e);
+                for (q = g->start[cell]; q < g->start[cell + 1]; q++) {
+                    size_t i = g->idx[q];
+                    double d2 = 0, f = t * rule_f(rule, r[i], ry);
+                    for (k = 0; k < 3; k++) d2 += (y[k] - x[3 * i + k]) * (y[k] - x[3 * i + k]);
+                    if (d2 <= f * f * (1 + 1e-9)) return 1;
+                }
+            }
+    return 0;
+}
+
+typedef struct {
+    size_t off_surface, bad_radius, conflicts, uncovered, probes;
+} report_t;
+
+static double tri_area(const mesh_t *m, size_t f, double *longest)
+{
+    const double *a = m->v + 3 * m->t[3 * f], *b = m->v + 3 * m->t[3 * f + 1], *c = m->v + 3 * m->t[3 * f + 2];
+    double e1[3], e2[3], e3[3], cr[3], l = 0;
+    int k;
+    for (k = 0; k < 3; k++) e1[k] = b[k] - a[k], e2[k] = c[k] - a[k], e3[k] = c[k] - b[k];
+    cr[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    cr[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    cr[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    l = fmax(fmax(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2], e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]),
+             e3[0] * e3[0] + e3[1] * e3[1] + e3[2] * e3[2]);
+    *longest = sqrt(l);
+    return 0.5 * sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+}
+
+/* Every guarantee of a completed run at scale t, by brute force. r_min: the smallest radius
+ * (the probe spacing is a quarter of it); rmax bounds every f. */
+static report_t check_mesh_run(const vpds_mesh *s, const mesh_t *m, const double *vr, radius_fn rf,
+                               vpds_rule rule, double t, double r_min, double r_max)
+{
+    report_t rep = {0};
+    size_t n = vpds_mesh_count(s), i, f;
+    const double *x = vpds_mesh_points(s), *r = vpds_mesh_radii(s), *ts = vpds_mesh_scales(s);
+    const double *bc = vpds_mesh_barycentrics(s);
+    const uint32_t *face = vpds_mesh_faces(s);
+    bucket_t g;
+    if (rule == VPDS_RULE_DEFAULT) rule = VPDS_RULE_SMALLER;
+    for (i = 0; i < n; i++) {
+        const uint32_t *tv = m->t + 3 * (size_t)face[i];
+        double sum = bc[3 * i] + bc[3 * i + 1] + bc[3 * i + 2], err = 0;
+        int k, q;
+        if (face[i] >= m->nt) { rep.off_surface++; continue; }
+        for (k = 0; k < 3; k++) {
+            double p = 0;
+            for (q = 0; q < 3; q++) p += bc[3 * i + q] * m->v[3 * tv[q] + k];
+            err = fmax(err, fabs(p - x[3 * i + k]));
+        }
+        if (fabs(sum - 1) > 1e-12 || bc[3 * i] < -1e-12 || bc[3 * i + 1] < -1e-12 || bc[3 * i + 2] < -1e-12 ||
+            err > 1e-12 * (1 + fabs(x[3 * i]) + fabs(x[3 * i + 1]) + fabs(x[3 * i + 2])))
+            rep.off_surface++;
+        if (fabs(rf(m, vr, face[i], bc + 3 * i, x + 3 * i) - r[i]) > 1e-12 * r[i]) rep.bad_radius++;
+    }
+    /* conflicts: j after i within ts[j] * f(r_i, r_j) */
+    bucket_build(&g, x, n, m, r_max * (ts[0] < INFINITY ? ts[0] : 1));
+    for (i = 0; i < n; i++) {
+        size_t j;
+        for (j = i + 1; j < n; j++) {
+            double d2 = 0, fr = ts[j] * rule_f(rule, r[i], r[j]);
+            int k;
+            for (k = 0; k < 3; k++) d2 += (x[3 * i + k] - x[3 * j + k]) * (x[3 * i + k] - x[3 * j + k]);
+            if (d2 < fr * fr * (1 - 1e-12)) rep.conflicts++;
+        }
+    }
+    /* coverage: a barycentric lattice on every triangle of area (corners and edges included) */
+    for (f = 0; f < m->nt; f++) {
+        double longest, area = tri_area(m, f, &longest);
+        const uint32_t *tv = m->t + 3 * f;
+        int a, b, steps;
+        if (!(area > 9.094947017729282e-13 * longest * longest)) continue;
+        steps = (int)ceil(longest / (0.25 * t * r_min));
+        if (steps < 2) steps = 2;
+        if (steps > 400) steps = 400;
+        for (a = 0; a <= steps; a++)
+            for (b = 0; a + b <= steps; b++) {
+                double bb[3], y[3], ry;
+                int k;
+                bb[1] = (double)a / steps;
+                bb[2] = (double)b / steps;
+                bb[0] = 1 - bb[1] - bb[2];
+                for (k = 0; k < 3; k++)
+                    y[k] = bb[0] * m->v[3 * tv[0] + k] + bb[1] * m->v[3 * tv[1] + k] + bb[2] * m->v[3 * tv[2] + k];
+                ry = rf(m, vr, (uint32_t)f, bb, y);
+                rep.probes++;
+                if (!covered_by_some(&g, x, r, y, ry, rule, t)) rep.uncovered++;
+            }
+    }
+    bucket_free(&g);
+    return rep;
+}
+
+static void expect_guarantees(const char *what, report_t rep, size_t n)
+{
+    CHECK_MSG(n > 0, "%s: no samples", what);
+    CHECK_MSG(rep.off_surface == 0, "%s: %zu samples off their triangle", what, rep.off_surface);
+    CHECK_MSG(rep.bad_radius == 0, "%s: %zu samples with a wrong radius", what, rep.bad_radius);
+    CHECK_MSG(rep.conflicts == 0, "%s: %zu pairs in conflict", what, rep.conflicts);
+    CHECK_MSG(rep.uncovered == 0, "%s: %zu of %zu probes uncovered", what, rep.uncovered, rep.probes);
+}
+
+static vpds_mesh_desc desc_for(const mesh_t *m)
+{
+    vpds_mesh_desc d = vpds_default_mesh_desc();
+    d.vertices = m->v;
+    d.n_vertices = m->nv;
+    d.triangles = m->t;
+    d.n_triangles = m->nt;
+    return d;
+}
+
+static vpds_mesh *run_mesh(const vpds_mesh_desc *d)
+{
+    vpds_mesh *s = NULL;
+    char msg[512];
+    vpds_status st = vpds_mesh_validate(d, msg, sizeof msg);
+    CHECK_MSG(st == VPDS_OK, "validate: %s", msg);
+    if (st != VPDS_OK || vpds_mesh_create(d, &s) != VPDS_OK) return NULL;
+    st = vpds_mesh_run(s);
+    CHECK_MSG(st == VPDS_OK, "run: %d %s", (int)st, vpds_mesh_last_error(s));
+    CHECK(vpds_mesh_get_stats(s).maximal);
+    CHECK(vpds_mesh_get_stats(s).delta == 0);
+    return s;
+}
+
+static void test_shapes(void)
+{
+    mesh_t sphere = icosphere(quick ? 3 : 6), tor = torus(1.0, 0.3, quick ? 16 : 40, quick ? 8 : 16);
+    mesh_t sq = {0}, sheet = {0};
+    vpds_mesh_desc d;
+    vpds_mesh *s;
+    int rule;
+    square_part(&sq, 0, 1, 7, 5, 0, 0.6, 3);
+    square_part(&sheet, 0, 1, 2, 2, 0, 0, 1);
+    square_part(&sheet, 0, 1, 2, 2, 1e-3, 0, 1); /* a second side 1e-3 above: a thin sheet */
+    r_const_val = quick ? 0.2 : 0.08;
+    for (rule = 1; rule <= 4; rule++) {
+        d = desc_for(&sphere);
+        d.radius = r_const_val;
+        d.rule = (vpds_rule)rule;
+        d.seed = (uint64_t)rule;
+        if ((s = run_mesh(&d))) {
+            expect_guarantees("icosphere", check_mesh_run(s, &sphere, NULL, r_const, d.rule, 1, r_const_val,
+                                                          r_const_val), vpds_mesh_count(s));
+            vpds_mesh_destroy(s);
+        }
+    }
+    d = desc_for(&tor);
+    d.radius = r_const_val;
+    if ((s = run_mesh(&d))) {
+        expect_guarantees("torus", check_mesh_run(s, &tor, NULL, r_const, d.rule, 1, r_const_val, r_const_val),
+                          vpds_mesh_count(s));
+        vpds_mesh_destroy(s);
+    }
+    d = desc_for(&sq);
+    d.radius = r_const_val / 2;
+    r_const_val /= 2;
+    if ((s = run_mesh(&d))) {
+        expect_guarantees("square", check_mesh_run(s, &sq, NULL, r_const, d.rule, 1, r_const_val, r_const_val),
+                          vpds_mesh_count(s));
+        vpds_mesh_destroy(s);
+    }
+    d = desc_for(&sheet);
+    d.radius = r_const_val;
+    if ((s = run_mesh(&d))) {
+        /* the sides are 1e-3 apart: a sample on one covers the other, so about one layer */
+        size_t n = vpds_mesh_count(s), top = 0, i;
+        expect_guarantees("sheet", check_mesh_run(s, &sheet, NULL, r_const, d.rule, 1, r_const_val, r_const_val), n);
+        for (i = 0; i < n; i++) top += vpds_mesh_points(s)[3 * i + 2] > 5e-4;
+        CHECK_MSG(top > 0 && top < n, "sheet: %zu of %zu on the upper side", top, n);
+        vpds_mesh_destroy(s);
+    }
+    mesh_free(&sphere);
+    mesh_free(&tor);
+    mesh_free(&sq);
+    mesh_free(&sheet);
+}
+
+/* Variable radii: per-vertex radii (each rule), a sizing callback, very different triangle sizes. */
+static void test_variable(void)
+{
+    mesh_t sphere = icosphere(quick ? 3 : 5), mixed = {0};
+    double *vr = (double *)malloc(sphere.nv * sizeof(double));
+    vpds_mesh_desc d;
+    vpds_mesh *s;
+    size_t i;
+    int rule;
+    double lo = quick ? 0.12 : 0.05;
+    for (i = 0; i < sphere.nv; i++) vr[i] = lo * (1.6 + 0.6 * sphere.v[3 * i + 2]); /* slope <= 0.36 lo */
+    for (rule = 1; rule <= 4; rule++) {
+        d = desc_for(&sphere);
+        d.vertex_radii = vr;
+        d.rule = (vpds_rule)rule;
+        d.seed = 10u + (uint64_t)rule;
+        if ((s = run_mesh(&d))) {
+            expect_guarantees("vertex radii", check_mesh_run(s, &sphere, vr, r_vertex, d.rule, 1, lo, 2.2 * lo),
+                              vpds_mesh_count(s));
+            vpds_mesh_destroy(s);
+        }
+    }
+    d = desc_for(&sphere);
+    d.sizing = sizing_z;
+    d.lipschitz = 0.02;
+    if ((s = run_mesh(&d))) {
+        expect_guarantees("sizing", check_mesh_run(s, &sphere, NULL, r_sizing, d.rule, 1, 0.04, 0.08),
+                          vpds_mesh_count(s));
+        CHECK(vpds_mesh_get_stats(s).sizing_calls > 0);
+        vpds_mesh_destroy(s);
+    }
+    /* one big triangle beside many small ones */
+    square_part(&mixed, 0, 0.5, quick ? 6 : 20, quick ? 6 : 20, 0, 0.3, 5);
+    {
+        uint32_t a = add_v(&mixed, 0.5, 0, 0), b = add_v(&mixed, 4, 0, 0), c = add_v(&mixed, 0.5, 1, 0);
+        add_t(&mixed, a, b, c);
+    }
+    d = desc_for(&mixed);
+    r_const_val = d.radius = quick ? 0.08 : 0.03;
+    if ((s = run_mesh(&d))) {
+        expect_guarantees("mixed sizes", check_mesh_run(s, &mixed, NULL, r_const, d.rule, 1, d.radius, d.radius),
+                          vpds_mesh_count(s));
+        vpds_mesh_destroy(s);
+    }
+    free(vr);
+    mesh_free(&sphere);
+    mesh_free(&mixed);
+}
+
+/* Refinement to smaller scales keeps the samples and is maximal at each. */
+static void test_refine(void)
+{
+    mesh_t sphere = icosphere(4);
+    vpds_mesh_desc d = desc_for(&sphere);
+    vpds_mesh *s;
+    size_t n1;
+    r_const_val = d.radius = quick ? 0.3 : 0.15;
+    if (!(s = run_mesh(&d))) return;
+    n1 = vpds_mesh_count(s);
+    CHECK(vpds_mesh_refine(s, 1.0) == VPDS_OK); /* the same scale: nothing to do */
+    CHECK(vpds_mesh_count(s) == n1);
+    CHECK(vpds_mesh_refine(s, 2.0) == VPDS_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(vpds_mesh_last_error(s), "below the current scale") != NULL);
+    CHECK(vpds_mesh_refine(s, 0.5) == VPDS_OK);
+    CHECK(vpds_mesh_count(s) > 2 * n1);
+    CHECK(vpds_mesh_scales(s)[0] == 1.0 && vpds_mesh_scales(s)[vpds_mesh_count(s) - 1] == 0.5);
+    expect_guarantees("refined", check_mesh_run(s, &sphere, NULL, r_const, d.rule, 0.5, d.radius, d.radius),
+                      vpds_mesh_count(s));
+    vpds_mesh_destroy(s);
+    mesh_free(&sphere);
+}
+
+static int same_samples(const vpds_mesh *a, const vpds_mesh *b)
+{
+    size_t n = vpds_mesh_count(a);
+    return n == vpds_mesh_count(b) && n > 0 &&
+           !memcmp(vpds_mesh_points(a), vpds_mesh_points(b), 3 * n * sizeof(double)) &&
+           !memcmp(vpds_mesh_radii(a), vpds_mesh_radii(b), n * sizeof(double)) &&
+           !memcmp(vpds_mesh_faces(a), vpds_mesh_faces(b), n * sizeof(uint32_t)) &&
+           !memcmp(vpds_mesh_barycentrics(a), vpds_mesh_barycentrics(b), 3 * n * sizeof(double));
+}
+
+typedef struct {
+    size_t calls, fail_at, live_bytes;
+} counting_t;
+
+static void *ca_alloc(size_t size, void *user)
+{
+    counting_t *a = (counting_t *)user;
+    a->calls++;
+    if (a->fail_at && a->calls == a->fail_at) return NULL;
+    a->live_bytes += size;
+    return malloc(size);
+}
+
+static void ca_free(void *p, size_t size, void *user)
+{
+    counting_t *a = (counting_t *)user;
+    a->live_bytes -= size;
+    free(p);
+}
+
+static int pause_every(const vpds_progress *p, void *user)
+{
+    (void)p;
+    return ++*(int *)user % 3 == 0;
+}
+
+/* Same seed, same bytes: again, through pauses, through a progress callback's pauses and
+ * through an allocation failure at every site; another seed, other points. */
+static void test_determinism(void)
+{
+    mesh_t sphere = icosphere(4);
+    double *vr = (double *)malloc(sphere.nv * sizeof(double));
+    vpds_mesh_desc d = desc_for(&sphere);
+    vpds_mesh *ref, *s;
+    vpds_status st;
+    counting_t ca = {0, 0, 0};
+    size_t i, k, sites;
+    int calls, ticks = 0;
+    for (i = 0; i < sphere.nv; i++) vr[i] = 0.15 + 0.05 * sphere.v[3 * i];
+    d.vertex_radii = vr;
+    d.seed = 42;
+    ref = run_mesh(&d);
+    if (!ref) return;
+    s = run_mesh(&d);
+    CHECK(s && same_samples(ref, s));
+    vpds_mesh_destroy(s);
+    d.seed = 43;
+    s = run_mesh(&d);
+    CHECK(s && !same_samples(ref, s));
+    vpds_mesh_destroy(s);
+    d.seed = 42;
+    d.budget = 97;
+    CHECK(vpds_mesh_create(&d, &s) == VPDS_OK);
+    for (calls = 0; (st = vpds_mesh_run(s)) == VPDS_PAUSED; calls++) {}
+    CHECK(st == VPDS_OK && calls > 10);
+    CHECK(same_samples(ref, s));
+    vpds_mesh_destroy(s);
+    d.budget = 0;
+    d.progress = pause_every;
+    d.progress_user = &ticks;
+    CHECK(vpds_mesh_create(&d, &s) == VPDS_OK);
+    for (calls = 0; (st = vpds_mesh_run(s)) == VPDS_PAUSED; calls++) {}
+    CHECK(st == VPDS_OK && calls > 2 && same_samples(ref, s));
+    vpds_mesh_destroy(s);
+    d.progress = NULL;
+    /* every allocation site fails once: the call says so, the retry gives the same points */
+    d.allocator.alloc = ca_alloc;
+    d.allocator.free = ca_free;
+    d.allocator.user = &ca;
+    CHECK(vpds_mesh_create(&d, &s) == VPDS_OK && vpds_mesh_run(s) == VPDS_OK);
+    vpds_mesh_destroy(s);
+    sites = ca.calls;
+    CHECK(ca.live_bytes == 0);
+    for (k = 1; k <= sites; k += quick ? 7 : 1) {
+        int failed = 0;
+        ca.calls = 0;
+        ca.fail_at = k;
+        while ((st = vpds_mesh_create(&d, &s)) == VPDS_ERR_OUT_OF_MEMORY) failed = 1;
+        CHECK(st == VPDS_OK);
+        while ((st = vpds_mesh_run(s)) == VPDS_ERR_OUT_OF_MEMORY) failed = 1;
+        CHECK_MSG(st == VPDS_OK && failed && same_samples(ref, s), "allocation %zu failing", k);
+        vpds_mesh_destroy(s);
+        CHECK(ca.live_bytes == 0);
+    }
+    ca.fail_at = 0;
+    vpds_mesh_destroy(ref);
+    free(vr);
+    mesh_free(&sphere);
+}
+
+/* Degenerate triangles are not sampled: adding them (a repeated vertex, three collinear ones)
+ * changes no point, only the face numbers they shift. */
+static void test_degenerate(void)
+{
+    mesh_t sq = {0}, more = {0};
+    vpds_mesh_desc d;
+    vpds_mesh *a, *b;
+    size_t i, f;
+    square_part(&sq, 0, 1, 4, 4, 0, 0.5, 9);
+    for (i = 0; i < sq.nv; i++) add_v(&more, sq.v[3 * i], sq.v[3 * i + 1], sq.v[3 * i + 2]);
+    for (f = 0; f < sq.nt; f++) {
+        add_t(&more, sq.t[3 * f], sq.t[3 * f + 1], sq.t[3 * f + 2]);
+        if (f % 3 == 0) add_t(&more, sq.t[3 * f], sq.t[3 * f], sq.t[3 * f + 1]); /* a repeated vertex */
+        if (f % 5 == 0) {
+            uint32_t p = add_v(&more, 0.25, 0.25, 0), q = add_v(&more, 0.5, 0.5, 0), w = add_v(&more, 2, 2, 0);
+            add_t(&more, p, q, w); /* collinear, and reaching off the square */
+        }
+    }
+    d = desc_for(&sq);
+    r_const_val = d.radius = 0.06;
+    a = run_mesh(&d);
+    d = desc_for(&more);
+    d.radius = r_const_val;
+    b = run_mesh(&d);
+    if (a && b) {
+        size_t n = vpds_mesh_count(a);
+        int same = n == vpds_mesh_count(b) &&
+                   !memcmp(vpds_mesh_points(a), vpds_mesh_points(b), 3 * n * sizeof(double));
+        CHECK_MSG(same, "degenerate triangles changed the samples (%zu vs %zu)", n, vpds_mesh_count(b));
+        for (i = 0; same && i < n; i++) {
+            const uint32_t *ta = sq.t + 3 * vpds_mesh_faces(a)[i], *tb = more.t + 3 * vpds_mesh_faces(b)[i];
+            CHECK(ta[0] == tb[0] && ta[1] == tb[1] && ta[2] == tb[2]);
+        }
+        expect_guarantees("with degenerate", check_mesh_run(b, &more, NULL, r_const, d.rule, 1, d.radius, d.radius), n);
+    }
+    vpds_mesh_destroy(a);
+    vpds_mesh_destroy(b);
+    mesh_free(&sq);
+    mesh_free(&more);
+}
+
+static double nan_sizing(const double *x, void *u)
+{
+    (void)u;
+    return x[0] > 0.5 ? NAN : 0.1;
+}
+
+static double jump_sizing(const double *x, void *u)
+{
+    (void)u;
+    return x[0] > 0.5 ? 0.2 : 0.05;
+}
+
+static void expect_refused(vpds_mesh_desc *d, vpds_status want, const char *words)
+{
+    char msg[512];
+    vpds_mesh *s = (vpds_mesh *)&msg; /* create must set it to NULL */
+    vpds_status st = vpds_mesh_validate(d, msg, sizeof msg);
+    CHECK_MSG(st == want && strstr(msg, words), "want %d '%s', got %d '%s'", (int)want, words, (int)st, msg);
+    CHECK(vpds_mesh_create(d, &s) == want && s == NULL);
+}
+
+static void test_bad_input(void)
+{
+    mesh_t sq = {0};
+    vpds_mesh_desc d;
+    double *vr, keep;
+    vpds_mesh *s;
+    vpds_status st;
+    uint32_t bad_t[3] = {0, 1, 99}, same_t[6] = {0, 0, 1, 2, 2, 2};
+    square_part(&sq, 0, 1, 3, 3, 0, 0.4, 2);
+    vr = (double *)malloc(sq.nv * sizeof(double));
+    for (size_t i = 0; i < sq.nv; i++) vr[i] = 0.1;
+    d = desc_for(&sq);
+    d.cookie = 0;
+    expect_refused(&d, VPDS_ERR_BAD_DESCRIPTOR, "vpds_default_mesh_desc");
+    d = desc_for(&sq);
+    d.n_triangles = 0;
+    expect_refused(&d, VPDS_ERR_INVALID_ARGUMENT, "at least one triangle");
+    d = desc_for(&sq);
+    keep = sq.v[3 * 5 + 1];
+    sq.v[3 * 5 + 1] = NAN;
+    expect_refused(&d, VPDS_ERR_INVALID_ARGUMENT, "vertex 5 coordinate 1");
+    sq.v[3 * 5 + 1] = INFINITY;
+    expect_refused(&d, VPDS_ERR_INVALID_ARGUMENT, "vertex 5 coordinate 1");
+    sq.v[3 * 5 + 1] = keep;
+    d.triangles = bad_t;
+    d.n_triangles = 1;
+    expect_refused(&d, VPDS_ERR_INVALID_ARGUMENT, "triangle 0 corner 2 is vertex 99");
+    d.triangles = same_t;
+    d.n_triangles = 2;
+    expect_refused(&d, VPDS_ERR_INVALID_ARGUMENT, "all 2 triangles are degenerate");
+    d = desc_for(&sq);
+    d.vertex_radii = vr;
+    vr[7] = 0;
+    expect_refused(&d, VPDS_ERR_INVALID_ARGUMENT, "vertex_radii[7] = 0");
+    vr[7] = -1;
+    expect_refused(&d, VPDS_ERR_INVALID_ARGUMENT, "vertex_radii[7] = -1");
+    vr[7] = 5; /* slope far above the limit on the triangles at vertex 7 */
+    expect_refused(&d, VPDS_ERR_INVALID_ARGUMENT, "Table 1");
+    vr[7] = 0.1;
+    d.sizing = sizing_z;
+    d.lipschitz = 0.1;
+    expect_refused(&d, VPDS_ERR_INVALID_ARGUMENT, "both set");
+    d = desc_for(&sq);
+    d.radius = -0.5;
+    expect_refused(&d, VPDS_ERR_INVALID_ARGUMENT, "desc.radius = -0.5");
+    d.radius = 0.1;
+    d.inhibition = 0.5;
+    expect_refused(&d, VPDS_ERR_UNSUPPORTED, "two radii");
+    d.inhibition = 1;
+    d.sizing = sizing_z;
+    expect_refused(&d, VPDS_ERR_INVALID_ARGUMENT, "lipschitz is required");
+    d.algorithm_version = 2;
+    d.lipschitz = 0.02;
+    expect_refused(&d, VPDS_ERR_UNSUPPORTED, "versions 3..");
+    d.algorithm_version = 0;
+    /* a sizing that returns NaN, one that breaks its L: named errors, then the same again */
+    d.sizing = nan_sizing;
+    CHECK(vpds_mesh_create(&d, &s) == VPDS_OK);
+    st = vpds_mesh_run(s);
+    CHECK_MSG(st == VPDS_ERR_SIZING && strstr(vpds_mesh_last_error(s), "sizing returned"), "%d %s", (int)st,
+              vpds_mesh_last_error(s));
+    CHECK(vpds_mesh_run(s) == VPDS_ERR_SIZING);
+    vpds_mesh_destroy(s);
+    d.sizing = jump_sizing;
+    d.lipschitz = 0.01;
+    CHECK(vpds_mesh_create(&d, &s) == VPDS_OK);
+    st = vpds_mesh_run(s);
+    CHECK_MSG(st == VPDS_ERR_LIPSCHITZ && strstr(vpds_mesh_last_error(s), "breaks lipschitz"), "%d %s", (int)st,
+              vpds_mesh_last_error(s));
+    vpds_mesh_destroy(s);
+    /* a radius far too small for the triangles is refused before any allocation */
+    d = desc_for(&sq);
+    d.radius = 1e-9;
+    CHECK(vpds_mesh_create(&d, &s) == VPDS_OK);
+    st = vpds_mesh_run(s);
+    CHECK_MSG(st == VPDS_ERR_OVERFLOW && strstr(vpds_mesh_last_error(s), "pieces"), "%d %s", (int)st,
+              vpds_mesh_last_error(s));
+    CHECK(vpds_mesh_count(s) == 0);
+    vpds_mesh_destroy(s);
+    CHECK(vpds_mesh_run(NULL) == VPDS_ERR_INVALID_ARGUMENT);
+    CHECK(vpds_mesh_count(NULL) == 0 && vpds_mesh_points(NULL) == NULL);
+    CHECK(strstr(vpds_mesh_last_error(NULL), "NULL") != NULL);
+    free(vr);
+    mesh_free(&sq);
+}
+
+/* Nearest-neighbour distance of each sample, averaged (brute force, a flat set). */
+static double mean_nn(const double *x, size_t n, int dim)
+{
+    double sum = 0;
+    size_t i, j;
+    for (i = 0; i < n; i++) {
+        double best = INFINITY;
+        for (j = 0; j < n; j++) {
+            double d2 = 0;
+            int k;
+            if (j == i) continue;
+            for (k = 0; k < dim; k++) d2 += (x[dim * i + k] - x[dim * j + k]) * (x[dim * i + k] - x[dim * j + k]);
+            if (d2 < best) best = d2;
+        }
+        sum += sqrt(best);
+    }
+    return sum / (double)n;
+}
+
+/* Bias-freeness: on the unit square made of small triangles on its left half and large ones on
+ * its right, the samples (the first ones above all) fall evenly on both halves, and count and
+ * nearest-neighbour distance
+ * match a box run of the same radius (over many seeds, within 4 standard errors). */
+static void test_bias(void)
+{
+    mesh_t sq = {0};
+    int seeds = quick ? 8 : 60, k;
+    double r = 0.05, cm = 0, cm2 = 0, cb = 0, cb2 = 0, nm = 0, nm2 = 0, nb = 0, nb2 = 0;
+    double dm = 0, dm2 = 0, fm = 0, fm2 = 0;
+    /* left: triangles far smaller than a disk (one piece each), right: two large ones */
+    square_part(&sq, 0, 0.5, 40, 80, 0, 0.7, 7);
+    square_part(&sq, 0.5, 1, 1, 1, 0, 0, 7);
+    for (k = 0; k < seeds; k++) {
+        vpds_mesh_desc d = desc_for(&sq);
+        vpds_desc bd = vpds_default_desc();
+        vpds_mesh *s = NULL;
+        vpds_sampler *b = NULL;
+        double *flat, c, nn;
+        size_t n, i;
+        long left = 0, right = 0;
+        d.radius = bd.radius = r;
+        d.seed = bd.seed = 1000u + (uint64_t)k;
+        if (vpds_mesh_create(&d, &s) != VPDS_OK || vpds_mesh_run(s) != VPDS_OK) { CHECK(0); return; }
+        if (vpds_create(&bd, &b) != VPDS_OK || vpds_run(b) != VPDS_OK) { CHECK(0); return; }
+        n = vpds_mesh_count(s);
+        flat = (double *)malloc(2 * n * sizeof(double));
+        for (i = 0; i < n; i++) {
+            flat[2 * i] = vpds_mesh_points(s)[3 * i];
+            flat[2 * i + 1] = vpds_mesh_points(s)[3 * i + 1];
+            if (flat[2 * i] < 0.5) left++; else right++;
+        }
+        /* the first samples are nearly independent uniform points: half of them on the left */
+        for (i = 0, c = 0; i < 20 && i < n; i++) c += flat[2 * i] < 0.5 ? 1 : -1;
+        fm += c, fm2 += c * c;
+        c = (double)n;
+        dm += (double)(left - right), dm2 += (double)(left - right) * (double)(left - right);
+        nn = mean_nn(flat, n, 2);
+        cm += c, cm2 += c * c, nm += nn, nm2 += nn * nn;
+        c = (double)vpds_count(b);
+        nn = mean_nn(vpds_points(b), vpds_count(b), 2);
+        cb += c, cb2 += c * c, nb += nn, nb2 += nn * nn;
+        free(flat);
+        vpds_mesh_destroy(s);
+        vpds_destroy(b);
+    }
+    {
+        double S = seeds, mc = cm / S, bc = cb / S, mn = nm / S, bn = nb / S;
+        double se_c = sqrt((cm2 / S - mc * mc + cb2 / S - bc * bc) / S), se_n = sqrt((nm2 / S - mn * mn + nb2 / S - bn * bn) / S);
+        double md = dm / S, z = md / sqrt((dm2 / S - md * md) / S + 1e-12);
+        double mf = fm / S, zf = mf / sqrt((fm2 / S - mf * mf) / S + 1e-12);
+        CHECK_MSG(fabs(zf) < 4, "first samples: left - right = %.2f of 20 per run (z = %.2f)", mf, zf);
+        CHECK_MSG(fabs(mc - bc) < 4 * se_c + 1e-9, "count: mesh %.2f, box %.2f (se %.2f)", mc, bc, se_c);
+        CHECK_MSG(fabs(mn - bn) < 4 * se_n + 1e-12, "nn: mesh %.5f, box %.5f (se %.5f)", mn, bn, se_n);
+        CHECK_MSG(fabs(z) < 4, "halves: left - right = %.2f per run (z = %.2f)", md, z);
+    }
+    mesh_free(&sq);
+}
+
+int main(void)
+{
+    quick = getenv("VPDS_TEST_QUICK") != NULL;
+    test_bad_input();
+    test_shapes();
+    test_variable();
+    test_refine();
+    test_degenerate();
+    test_determinism();
+    test_bias();
+    CHECK_DONE();
+}
