@@ -8,6 +8,7 @@ from ._core import ALGORITHM_VERSION, MAX_DIM, RULES, PoissonDisk, Progressive, 
 from ._errors import (VpdsDomainError, VpdsError, VpdsSizingError, VpdsStateError, VpdsUnsupportedError,
                       VpdsValueError)
 from .domain import Domain, estimate_radius
+from .mesh import MeshSampler, MeshSamples, sample_mesh
 from ._vpds import ffi as _ffi, lib as _lib
 
 __version__ = _ffi.string(_lib.vpds_version_string()).decode()
@@ -17,4 +18,4 @@ STREAM_TOLERANCE: float = float(_lib.VPDS_STREAM_TOLERANCE)
 STREAM_DOMAIN_TOLERANCE: float = float(_lib.VPDS_STREAM_DOMAIN_TOLERANCE)
 __all__ = ["PoissonDisk", "SizingGrid", "VpdsError", "VpdsValueError", "VpdsSizingError",
            "VpdsUnsupportedError", "VpdsStateError", "RULES", "STREAM_TOLERANCE", "STREAM_DOMAIN_TOLERANCE", "VpdsDomainError", "Domain",
-           "Progressive", "estimate_radius", "ALGORITHM_VERSION", "MAX_DIM", "__version__"]
+           "Progressive", "estimate_radius", "sample_mesh", "MeshSampler", "MeshSamples", "ALGORITHM_VERSION", "MAX_DIM", "__version__"]

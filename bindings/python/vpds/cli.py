@@ -92,6 +92,9 @@ def _sample(args: argparse.Namespace, engine: PoissonDisk, expected: float) -> N
 
 
 def cmd_sample(args: argparse.Namespace) -> int:
+    if args.mesh:
+        from .cli_mesh import cmd_sample_mesh
+        return cmd_sample_mesh(args)
     dim = args.dim
     if not 1 <= dim <= MAX_DIM:
         raise UsageError(f"--dim {dim}: must be in 1..{MAX_DIM}")
@@ -202,6 +205,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--force", action="store_true", help="run even when the estimated memory "
                    "exceeds what is available")
     s.set_defaults(func=cmd_sample)
+    from .cli_mesh import add_mesh_arguments
+    add_mesh_arguments(s)
     from .cli_tiles import add_tile_arguments  # the tiled form: vpds sample --tiles ... -o X.zarr
     add_tile_arguments(s, cmd_sample)
     from .cli_analyze import add_analyze_parser

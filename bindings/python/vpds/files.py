@@ -69,10 +69,13 @@ def _atomic(path: Path, write: Callable[[BinaryIO], None]) -> None:
 def write_points(path: Path, x: npt.NDArray[np.float64], r: npt.NDArray[np.float64],
                  t: npt.NDArray[np.float64], fixed: npt.NDArray[np.bool_],
                  meta: Optional[dict[str, Any]] = None,
-                 arrays: Optional[dict[str, npt.NDArray[Any]]] = None) -> None:
+                 arrays: Optional[dict[str, npt.NDArray[Any]]] = None,
+                 columns: Optional[dict[str, npt.NDArray[Any]]] = None) -> None:
     """Samples x (n, d) with r, t and fixed (n,) as .npy: the points; .npz: points, radii, scales,
     fixed, meta (and `arrays`); .csv: x0.., r, t, fixed; .ply: x, y, z (zero-padded below 3D),
-    radius and t as vertex properties."""
+    radius and t as vertex properties. `columns`: more per-sample values (n,) by name, in .npz
+    as arrays, in .csv as columns and in .ply as properties (int for an integer array)."""
+    cols = columns or {}
     suffix = path.suffix.lower()
     n, d = x.shape
     info = json.dumps(meta or {}, sort_keys=True)
@@ -81,11 +84,12 @@ def write_points(path: Path, x: npt.NDArray[np.float64], r: npt.NDArray[np.float
     elif suffix == ".npz":
         # Any: savez's annotations would have **extra hold its allow_pickle flag too
         extra: dict[str, Any] = {f"meta_{k}": v for k, v in (arrays or {}).items()}
+        extra.update(cols)
         _atomic(path, lambda f: np.savez(f, points=x, radii=r, scales=t, fixed=fixed,
                                          meta=np.array(info), **extra))
     elif suffix == ".csv":
-        header = ",".join([f"x{k}" for k in range(d)] + ["r", "t", "fixed"])
-        table = np.column_stack([x, r, t, fixed.astype(float)])
+        header = ",".join([f"x{k}" for k in range(d)] + ["r", "t", "fixed"] + list(cols))
+        table = np.column_stack([x, r, t, fixed.astype(float)] + [np.asarray(c, float) for c in cols.values()])
         # the parameters last, as a comment: readers that skip the header row still work
         _atomic(path, lambda f: np.savetxt(f, table, delimiter=",", header=header, comments="",
                                            footer=f"# vpds {info}", fmt="%.17g"))
@@ -96,10 +100,13 @@ def write_points(path: Path, x: npt.NDArray[np.float64], r: npt.NDArray[np.float
         def ply(f: BinaryIO) -> None:
             f.write(b"ply\nformat ascii 1.0\ncomment libvpds sample\n")
             f.write(f"comment vpds {info}\n".encode())
+            props = "".join(f"property {'int' if np.issubdtype(np.asarray(c).dtype, np.integer) else 'double'}"
+                            f" {name}\n" for name, c in cols.items())
             f.write(f"element vertex {n}\nproperty double x\nproperty double y\n"
-                    "property double z\nproperty double radius\nproperty double t\n"
+                    f"property double z\nproperty double radius\nproperty double t\n{props}"
                     "end_header\n".encode())
-            np.savetxt(f, np.column_stack([xyz, r, t]), fmt="%.17g")
+            np.savetxt(f, np.column_stack([xyz, r, t] + [np.asarray(c, float) for c in cols.values()]),
+                       fmt="%.17g")
         _atomic(path, ply)
     else:
         raise UsageError(f"-o {path}: use {', '.join(OUTPUT_SUFFIXES)}")

@@ -515,3 +515,41 @@ def plot_analysis(path: Path, x: FloatArray, r: FloatArray, lo: FloatArray, hi: 
     """Write analysis_figure(...) as a PNG at path."""
     fig = analysis_figure(x, r, lo, hi, report, rule, lipschitz, scale, title=title, dpi=dpi)
     fig.savefig(path, dpi=dpi)
+
+
+# -- a sampled mesh --------------------------------------------------------------------------------
+
+
+def mesh_figure(vertices: FloatArray, faces: npt.NDArray[Any], points: FloatArray, title: str,
+                *, dpi: float = 150) -> Figure:
+    """The mesh as light shaded triangles and its samples as dots, in two views (front, and
+    turned half a turn) so that no side is hidden; the axes keep the mesh's proportions."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # type: ignore[import-untyped]
+    fig = _new_figure(figsize=(12, 5.5), dpi=dpi, layout="constrained")
+    v = np.asarray(vertices, dtype=float)
+    tris = v[np.asarray(faces, dtype=np.int64)]
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    extent = np.maximum(hi - lo, 0.05 * max(float((hi - lo).max()), 1e-12))
+    centre = (lo + hi) / 2
+    normal = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+    length = np.linalg.norm(normal, axis=1, keepdims=True)
+    shade = 0.55 + 0.4 * np.abs((normal / np.where(length > 0, length, 1)) @ np.array([0.3, -0.5, 0.8]))
+    for k, azim in enumerate((-60, 120)):
+        ax = fig.add_subplot(1, 2, k + 1, projection="3d")
+        ax.add_collection3d(Poly3DCollection(tris, facecolors=np.column_stack([shade] * 3 + [np.full(len(shade), 0.35)]),
+                                             edgecolors=(0.5, 0.5, 0.5, 0.15), linewidths=0.2))
+        ax.scatter(points[:, 0], points[:, 1], points[:, 2], s=max(0.5, min(6.0, 6e4 / max(len(points), 1))),
+                   c="tab:red", depthshade=True, linewidths=0)
+        for setter, c, e in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, extent):
+            setter(c - e / 2, c + e / 2)
+        ax.set_box_aspect(tuple(float(e) for e in extent), zoom=1.3)
+        ax.view_init(elev=35, azim=azim)
+        ax.set_axis_off()
+    fig.suptitle(_wrap(title, 110))
+    return fig
+
+
+def plot_mesh(path: Path, vertices: FloatArray, faces: npt.NDArray[Any], points: FloatArray,
+              title: str, *, dpi: float = 150) -> None:
+    """Write mesh_figure(...) as a PNG at path."""
+    mesh_figure(vertices, faces, points, title, dpi=dpi).savefig(path, dpi=dpi)

@@ -1,0 +1,178 @@
+"""Maximal Poisson-disk sampling on triangle meshes (the C library's vpds_mesh_*).
+
+    >>> import numpy as np, vpds
+    >>> v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], float)
+    >>> f = np.array([[0, 1, 2], [1, 3, 2]])
+    >>> s = vpds.sample_mesh(v, f, radius=0.05, rng=1)
+    >>> s.points.shape[1], bool(s.maximal)
+    (3, True)
+
+The sampled set is the union of the triangles of positive area; distances are Euclidean in
+R^3; conflicts and coverage follow the rule as in a box. A completed run is conflict-free,
+maximal (every point of every triangle, edges included, covered) and bias-free (each sample
+uniform by area over the free part of the surface when it is placed).
+"""
+from __future__ import annotations
+
+from typing import Any, NamedTuple, Optional, Union
+
+import numpy as np
+import numpy.typing as npt
+
+from ._callbacks import take, raise_failure
+from ._core import RULES, _CHUNK
+from ._errors import _raise, created
+from ._scipy_compat import _seed_from
+from ._typing import RngLike, SizingFunction
+from ._vpds import ffi, lib
+
+__all__ = ["MeshSamples", "sample_mesh", "MeshSampler"]
+
+FloatArray = npt.NDArray[np.float64]
+
+
+class MeshSamples(NamedTuple):
+    """Samples on a mesh, in insertion order."""
+    points: FloatArray                  # (n, 3)
+    faces: npt.NDArray[np.int64]        # (n,): the triangle of each sample (a row of `faces`)
+    barycentrics: FloatArray            # (n, 3): weights of the triangle's vertices, summing to 1
+    radii: FloatArray                   # (n,): r at each sample
+    scales: FloatArray                  # (n,): the scale t each sample was placed at
+    maximal: bool                       # the run completed: every point of the surface covered
+    delta: float                        # 0, or the precision limit's largest piece left active
+
+
+def _mesh_arrays(vertices: Any, faces: Any) -> tuple[FloatArray, npt.NDArray[np.uint32]]:
+    """(n, 3) float64 vertices and (m, 3) uint32 faces, from arrays or a trimesh.Trimesh-like
+    object (anything with .vertices and .faces)."""
+    if faces is None and hasattr(vertices, "vertices") and hasattr(vertices, "faces"):
+        vertices, faces = vertices.vertices, vertices.faces
+    if faces is None:
+        raise ValueError("faces: give the (m, 3) triangle indices, or pass a mesh object with "
+                         ".vertices and .faces (a trimesh.Trimesh)")
+    v = np.ascontiguousarray(vertices, dtype=np.float64)
+    if v.ndim != 2 or v.shape[1] != 3:
+        raise ValueError(f"vertices: shape {v.shape}, expected (n, 3)")
+    f_in = np.asarray(faces)
+    if f_in.ndim != 2 or f_in.shape[1] != 3:
+        raise ValueError(f"faces: shape {f_in.shape}, expected (m, 3)")
+    if f_in.size and not np.issubdtype(f_in.dtype, np.integer):
+        raise ValueError(f"faces: dtype {f_in.dtype}, expected integer vertex indices")
+    if f_in.size and (f_in.min() < 0 or f_in.max() > np.iinfo(np.uint32).max):
+        bad = int(np.argmax((f_in < 0).any(axis=1) | (f_in > np.iinfo(np.uint32).max).any(axis=1)))
+        raise ValueError(f"faces: triangle {bad} = {f_in[bad].tolist()} has an index out of range "
+                         f"(vertices: {len(v)})")
+    return v, np.ascontiguousarray(f_in, dtype=np.uint32)
+
+
+class MeshSampler:
+    """A mesh and its samples, refined in place: run() to maximal at t = 1, refine(t) to a
+    smaller scale. The arrays are copied by the library at construction."""
+
+    def __init__(self, vertices: Any, faces: Any = None, *, radius: float = 0.05,
+                 sizing: Optional[SizingFunction] = None, vertex_radii: Optional[npt.ArrayLike] = None,
+                 lipschitz: Optional[float] = None, rule: str = "smaller", inhibition: float = 1.0,
+                 coverage: float = 1.0, rng: RngLike = None) -> None:
+        v, f = _mesh_arrays(vertices, faces)
+        if rule not in RULES:
+            raise ValueError(f"rule = {rule!r}: one of {sorted(RULES)}")
+        self.d = 3  # what the sizing callback's owner tells it: points of R^3
+        self._callback_error: Optional[BaseException] = None
+        self._sizing_fn = sizing
+        self.rule = rule
+        desc = ffi.new("vpds_mesh_desc *", lib.vpds_default_mesh_desc())
+        self._keep: list[Any] = [v, f]
+        desc.vertices = ffi.cast("const double *", ffi.from_buffer(v))
+        desc.n_vertices = len(v)
+        desc.triangles = ffi.cast("const uint32_t *", ffi.from_buffer(f))
+        desc.n_triangles = len(f)
+        desc.radius = float(radius)
+        if vertex_radii is not None:
+            vr = np.ascontiguousarray(vertex_radii, dtype=np.float64)
+            if vr.shape != (len(v),):
+                raise ValueError(f"vertex_radii: shape {vr.shape}, expected ({len(v)},): one radius per vertex")
+            self._keep.append(vr)
+            desc.vertex_radii = ffi.cast("const double *", ffi.from_buffer(vr))
+        if sizing is not None:
+            if not callable(sizing):
+                raise ValueError(f"sizing: a callable r(x) of (m, 3) points, not {type(sizing).__name__} "
+                                 "(a constant is `radius`, per-vertex values `vertex_radii`)")
+            self._handle = ffi.new_handle(self)
+            desc.sizing_batch = lib.vpds_py_sizing_batch
+            desc.sizing_user = self._handle
+        if lipschitz is not None:
+            desc.lipschitz = float(lipschitz)
+        desc.rule = RULES[rule]
+        desc.inhibition = float(inhibition)
+        desc.coverage = float(coverage)
+        desc.seed = _seed_from(rng)
+        self._m = created(lib.vpds_mesh_validate, lib.vpds_mesh_create, lib.vpds_mesh_destroy,
+                          "vpds_mesh", desc)
+        self.n_faces = len(f)
+
+    def _check(self, st: int) -> int:
+        cause = take(self, "_callback_error")
+        if st < 0 or cause is not None:
+            message = ffi.string(lib.vpds_mesh_last_error(self._m)).decode()
+            if cause is None:
+                _raise(st, message)
+            raise_failure(st, message, cause, "sizing")
+        return st
+
+    def _drive(self, call: Any) -> None:
+        """Call in chunks of work until done: Ctrl-C stops between chunks, state kept."""
+        lib.vpds_mesh_set_budget(self._m, _CHUNK)
+        while self._check(call()) == lib.VPDS_PAUSED:
+            pass
+
+    def run(self) -> "MeshSampler":
+        """Sample to maximal at scale 1."""
+        self._drive(lambda: lib.vpds_mesh_run(self._m))
+        return self
+
+    def refine(self, t: float) -> "MeshSampler":
+        """Add samples until maximal at the scale t (below the current one; before any run, the
+        first scale)."""
+        t = float(t)
+        self._drive(lambda: lib.vpds_mesh_refine(self._m, t))
+        return self
+
+    @property
+    def samples(self) -> MeshSamples:
+        n = int(lib.vpds_mesh_count(self._m))
+        st = lib.vpds_mesh_get_stats(self._m)
+
+        def arr(ptr: Any, k: int, dtype: Any) -> Any:
+            if n == 0:
+                return np.empty((0, k) if k > 1 else (0,), dtype=dtype)
+            a = np.frombuffer(ffi.buffer(ptr, n * k * np.dtype(dtype).itemsize), dtype=dtype).copy()
+            return a.reshape(n, k) if k > 1 else a
+
+        return MeshSamples(points=arr(lib.vpds_mesh_points(self._m), 3, np.float64),
+                           faces=arr(lib.vpds_mesh_faces(self._m), 1, np.uint32).astype(np.int64),
+                           barycentrics=arr(lib.vpds_mesh_barycentrics(self._m), 3, np.float64),
+                           radii=arr(lib.vpds_mesh_radii(self._m), 1, np.float64),
+                           scales=arr(lib.vpds_mesh_scales(self._m), 1, np.float64),
+                           maximal=bool(st.maximal), delta=float(st.delta))
+
+
+def sample_mesh(vertices: Any, faces: Any = None, *, radius: float = 0.05,
+                sizing: Optional[SizingFunction] = None, vertex_radii: Optional[npt.ArrayLike] = None,
+                lipschitz: Optional[float] = None, rule: str = "smaller", inhibition: float = 1.0,
+                coverage: float = 1.0, rng: RngLike = None, t: Union[float, int] = 1.0) -> MeshSamples:
+    """A maximal Poisson-disk sampling of a triangle mesh.
+
+    vertices, faces: (n, 3) coordinates and (m, 3) vertex indices, or a trimesh.Trimesh (or any
+    object with .vertices and .faces) as `vertices`. The radius: `radius` (a constant),
+    `vertex_radii` (one per vertex, linear over each triangle) or `sizing` (a vectorised r(x)
+    of (k, 3) points, with its `lipschitz`). rule, inhibition, coverage as for PoissonDisk (this
+    version needs inhibition == coverage). rng: an int seed (the C seed) or a numpy Generator.
+    t: the scale (1: the radius itself).
+    """
+    m = MeshSampler(vertices, faces, radius=radius, sizing=sizing, vertex_radii=vertex_radii,
+                    lipschitz=lipschitz, rule=rule, inhibition=inhibition, coverage=coverage, rng=rng)
+    if float(t) == 1.0:
+        m.run()
+    else:
+        m.refine(float(t))
+    return m.samples
