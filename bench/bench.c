@@ -2,7 +2,11 @@
 /* libvpds workloads for `make bench`. Prints "name n seconds peak_bytes" per line.
  * usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION | ramp RULE | floor N DIM
  *        | annulus RADIUS (a domain) | stream DIM RADIUS N STEPS (prints one line per N/STEPS samples: the cost along n)
- *        | threads DIM RADIUS TILES THREADS (vpds_tiling_run of TILES per axis on THREADS threads) */
+ *        | threads DIM RADIUS TILES THREADS (vpds_tiling_run of TILES per axis on THREADS threads)
+ *        | mesh square|sphere RADIUS (the unit square as two triangles, or the unit sphere as an
+ *          icosahedron split into 40^2 triangles per face: vpds_mesh_run)
+ *        | meshfile FILE RADIUS (vertices and triangles from a text file: "nv nt", then nv lines
+ *          of x y z, then nt lines of i j k) */
 #include "rng.h"
 #include "vpds.h"
 #include <stdio.h>
@@ -99,6 +103,91 @@ static int tiled(vpds_desc *d, uint64_t per_axis, int threads)
     return 0;
 }
 
+/* The unit sphere: each face of an icosahedron split into k*k triangles, pushed onto it. */
+static void icosphere(int k, double **v_out, uint32_t **t_out, size_t *nv, size_t *nt)
+{
+    static const int f[20][3] = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9},
+                                 {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2},
+                                 {3, 2, 6}, {3, 6, 8}, {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10},
+                                 {8, 6, 7}, {9, 8, 1}};
+    double p = (1 + sqrt(5.0)) / 2, ico[12][3] = {{-1, p, 0}, {1, p, 0}, {-1, -p, 0}, {1, -p, 0},
+                                                  {0, -1, p}, {0, 1, p}, {0, -1, -p}, {0, 1, -p},
+                                                  {p, 0, -1}, {p, 0, 1}, {-p, 0, -1}, {-p, 0, 1}};
+    size_t per = (size_t)((k + 1) * (k + 2) / 2);
+    double *v = (double *)malloc(20 * per * 3 * sizeof(double));
+    uint32_t *t = (uint32_t *)malloc(20 * (size_t)k * (size_t)k * 3 * sizeof(uint32_t));
+    int fi, a, b, c;
+    *nv = *nt = 0;
+    for (fi = 0; fi < 20; fi++) {
+        size_t base = *nv;
+        for (a = 0; a <= k; a++)
+            for (b = 0; a + b <= k; b++) {
+                double q[3], n = 0;
+                for (c = 0; c < 3; c++) {
+                    q[c] = ico[f[fi][0]][c] + (double)a / k * (ico[f[fi][1]][c] - ico[f[fi][0]][c]) +
+                           (double)b / k * (ico[f[fi][2]][c] - ico[f[fi][0]][c]);
+                    n += q[c] * q[c];
+                }
+                for (c = 0; c < 3; c++) v[3 * *nv + (size_t)c] = q[c] / sqrt(n);
+                (*nv)++;
+            }
+#define IDX(a, b) (uint32_t)(base + (size_t)((a) * (2 * k + 3 - (a)) / 2 + (b)))
+        for (a = 0; a < k; a++)
+            for (b = 0; a + b < k; b++) {
+                uint32_t *o = t + 3 * (*nt)++;
+                o[0] = IDX(a, b), o[1] = IDX(a + 1, b), o[2] = IDX(a, b + 1);
+                if (a + b + 1 < k) {
+                    o = t + 3 * (*nt)++;
+                    o[0] = IDX(a + 1, b), o[1] = IDX(a + 1, b + 1), o[2] = IDX(a, b + 1);
+                }
+            }
+#undef IDX
+    }
+    *v_out = v;
+    *t_out = t;
+}
+
+static int run_mesh(const char *name, const double *v, size_t nv, const uint32_t *t, size_t nt, double radius)
+{
+    vpds_mesh_desc md = vpds_default_mesh_desc();
+    vpds_mesh *m;
+    double t0;
+    md.vertices = v;
+    md.n_vertices = nv;
+    md.triangles = t;
+    md.n_triangles = nt;
+    md.radius = radius;
+    md.seed = 1;
+    if (vpds_mesh_create(&md, &m) != VPDS_OK) return 1;
+    t0 = now();
+    if (vpds_mesh_run(m) != VPDS_OK) {
+        fprintf(stderr, "%s: %s\n", name, vpds_mesh_last_error(m));
+        return 1;
+    }
+    printf("%s %zu %.6f %zu\n", name, vpds_mesh_count(m), now() - t0, vpds_mesh_get_stats(m).peak_bytes);
+    vpds_mesh_destroy(m);
+    return 0;
+}
+
+static int mesh_file(const char *path, double radius)
+{
+    FILE *f = fopen(path, "r");
+    size_t nv, nt, i;
+    double *v;
+    uint32_t *t;
+    int ok, rc;
+    if (!f || fscanf(f, "%zu %zu", &nv, &nt) != 2) return 1;
+    v = (double *)malloc(3 * nv * sizeof(double));
+    t = (uint32_t *)malloc(3 * nt * sizeof(uint32_t));
+    for (i = 0, ok = 1; ok && i < 3 * nv; i++) ok = fscanf(f, "%lf", v + i) == 1;
+    for (i = 0; ok && i < 3 * nt; i++) ok = fscanf(f, "%u", t + i) == 1;
+    fclose(f);
+    rc = ok ? run_mesh("meshfile", v, nv, t, nt, radius) : 1;
+    free(v);
+    free(t);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     vpds_desc d = vpds_default_desc();
@@ -140,6 +229,21 @@ int main(int argc, char **argv)
                  : !strcmp(argv[2], "bigger") ? VPDS_RULE_BIGGER : VPDS_RULE_SMALLER;
         return run(argv[2], &d);
     }
+    if (argc >= 4 && !strcmp(argv[1], "mesh")) {
+        static const double sq_v[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+        static const uint32_t sq_t[6] = {0, 1, 2, 1, 3, 2};
+        double *v;
+        uint32_t *t;
+        size_t nv, nt;
+        int rc;
+        if (!strcmp(argv[2], "square")) return run_mesh("mesh-square", sq_v, 4, sq_t, 2, atof(argv[3]));
+        icosphere(40, &v, &t, &nv, &nt);
+        rc = run_mesh("mesh-sphere", v, nv, t, nt, atof(argv[3]));
+        free(v);
+        free(t);
+        return rc;
+    }
+    if (argc >= 4 && !strcmp(argv[1], "meshfile")) return mesh_file(argv[2], atof(argv[3]));
     if (argc >= 4 && !strcmp(argv[1], "floor")) {
         /* the floor: as many uniform random points with the library's own generator */
         size_t n = (size_t)atof(argv[2]), i, dim = (size_t)atoi(argv[3]);
@@ -155,6 +259,6 @@ int main(int argc, char **argv)
         return 0;
     }
     fprintf(stderr, "usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION | ramp RULE"
-                    " | floor N DIM | stream DIM RADIUS N STEPS\n");
+                    " | floor N DIM | stream DIM RADIUS N STEPS | mesh square|sphere RADIUS | meshfile FILE RADIUS\n");
     return 2;
 }

@@ -249,6 +249,7 @@ static vpds_status take_arrays(vpds_mesh *s, const vpds_mesh_desc *d, double *lo
     s->view.v = s->v;
     s->view.tri = s->tri;
     s->view.vr = s->vr;
+    s->view.n_vertices = s->n_v;
     s->view.live = s->live;
     s->view.area = s->area;
     s->view.longest = s->longest;

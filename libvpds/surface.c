@@ -13,7 +13,8 @@
 /* a piece smaller than this fraction of a disk's area never splits: darts, which land by
  * area, would not find it (a sliver's pieces keep its shape) */
 #define MIN_AREA_FRACTION 9.094947017729282e-13 /* 2^-40 */
-#define SEED_COUNT_MAX 4294967296.0             /* 2^32 seed pieces: refused beyond */
+#define SEED_COUNT_MAX 1099511627776.0          /* 2^40 seed pieces (never stored): refused beyond */
+#define SEED_EDGE_MAX 67108864.0                /* 2^26 per edge: lattice coordinates stay exact */
 
 void vpdsi_surface_init(vpdsi_surface *s)
 {
@@ -27,11 +28,16 @@ static void release_pieces(vpdsi_surface *s, vpdsi_mem *m)
     vpdsi_mem_free(m, s->next, s->cap_next * sizeof *s->next);
     vpdsi_mem_free(m, s->cum, s->cap_cum * sizeof *s->cum);
     vpdsi_mem_free(m, s->near, s->cap_near * sizeof *s->near);
+    vpdsi_mem_free(m, s->cache, s->cap_cache * sizeof *s->cache);
+    vpdsi_mem_free(m, s->seed_m, s->cap_seed_m * sizeof *s->seed_m);
+    vpdsi_mem_free(m, s->tri_cum, s->cap_tri_cum * sizeof *s->tri_cum);
     s->cur = s->next = NULL;
-    s->cum = NULL;
-    s->near = NULL;
+    s->cum = s->tri_cum = NULL;
+    s->near = s->cache = NULL;
+    s->seed_m = NULL;
     s->n_cur = s->n_next = s->cap_cur = s->cap_next = s->cap_cum = s->cap_near = s->n_near = 0;
-    s->cum_ready = 0;
+    s->n_cache = s->cap_cache = s->cap_seed_m = s->cap_tri_cum = 0;
+    s->cum_ready = s->cache_ok = s->implicit = 0;
 }
 
 void vpdsi_surface_release(vpdsi_surface *s, vpdsi_mem *m)
@@ -50,38 +56,41 @@ void vpdsi_surface_begin(vpdsi_surface *s, double t)
     s->phase = VPDSI_SURF_SEED;
     s->pos = 0;
     s->n_cur = s->n_next = 0;
-    s->cum_ready = 0;
-    s->seed_checked = 0;
+    s->cum_ready = s->cache_ok = s->implicit = 0;
 }
 
 /* ---- geometry of pieces ---- */
 
 /* The point of live triangle k at lattice coordinates (i, j) of `level`: uv its parameters
- * along the edges v0->v1 and v0->v2 (exact), x its position. */
-static void lattice_point(const vpdsi_trimesh *mesh, uint32_t k, unsigned level, uint64_t i,
-                          uint64_t j, double *uv, double *x)
+ * along the edges v0->v1 and v0->v2, x its position. i / m is rounded once and scaled by a power
+ * of two, so a point has the same bits at every level that holds it (shared corners agree). */
+static void lattice_point(const vpdsi_trimesh *mesh, uint64_t m, uint32_t k, double unit,
+                          uint64_t i, uint64_t j, double *uv, double *x)
 {
     const uint32_t *t = mesh->tri + 3 * (size_t)mesh->live[k];
     const double *a = mesh->v + 3 * (size_t)t[0], *b = mesh->v + 3 * (size_t)t[1];
     const double *c = mesh->v + 3 * (size_t)t[2];
-    double u = ldexp((double)i, -(int)level), v = ldexp((double)j, -(int)level);
+    /* unit = 2^-level: the product is exact */
+    double u = (double)i / (double)m * unit, v = (double)j / (double)m * unit;
     int q;
     uv[0] = u;
     uv[1] = v;
     for (q = 0; q < 3; q++) x[q] = a[q] + u * (b[q] - a[q]) + v * (c[q] - a[q]);
 }
 
-static void piece_corners(const vpdsi_trimesh *mesh, const vpdsi_piece *p, double uv[3][2],
-                          double x[3][3])
+static void piece_corners(const vpdsi_surface *s, const vpdsi_trimesh *mesh, const vpdsi_piece *p,
+                          double uv[3][2], double x[3][3])
 {
+    uint64_t m = s->seed_m[p->tri];
+    double unit = ldexp(1.0, -(int)p->level);
     if (p->down) {
-        lattice_point(mesh, p->tri, p->level, p->i + 1, p->j, uv[0], x[0]);
-        lattice_point(mesh, p->tri, p->level, p->i, p->j + 1, uv[1], x[1]);
-        lattice_point(mesh, p->tri, p->level, p->i + 1, p->j + 1, uv[2], x[2]);
+        lattice_point(mesh, m, p->tri, unit, p->i + 1, p->j, uv[0], x[0]);
+        lattice_point(mesh, m, p->tri, unit, p->i, p->j + 1, uv[1], x[1]);
+        lattice_point(mesh, m, p->tri, unit, p->i + 1, p->j + 1, uv[2], x[2]);
     } else {
-        lattice_point(mesh, p->tri, p->level, p->i, p->j, uv[0], x[0]);
-        lattice_point(mesh, p->tri, p->level, p->i + 1, p->j, uv[1], x[1]);
-        lattice_point(mesh, p->tri, p->level, p->i, p->j + 1, uv[2], x[2]);
+        lattice_point(mesh, m, p->tri, unit, p->i, p->j, uv[0], x[0]);
+        lattice_point(mesh, m, p->tri, unit, p->i + 1, p->j, uv[1], x[1]);
+        lattice_point(mesh, m, p->tri, unit, p->i, p->j + 1, uv[2], x[2]);
     }
 }
 
@@ -98,14 +107,22 @@ static vpdsi_piece child_of(const vpdsi_piece *p, int q)
     return c;
 }
 
-static double piece_area(const vpdsi_trimesh *mesh, const vpdsi_piece *p)
+static double piece_area(const vpdsi_surface *s, const vpdsi_trimesh *mesh, const vpdsi_piece *p)
 {
-    return ldexp(mesh->area[p->tri], -2 * (int)p->level);
+    double m = (double)s->seed_m[p->tri];
+    return ldexp(mesh->area[p->tri] / (m * m), -2 * (int)p->level);
 }
 
-static double piece_edge(const vpdsi_trimesh *mesh, const vpdsi_piece *p)
+static double piece_edge(const vpdsi_surface *s, const vpdsi_trimesh *mesh, const vpdsi_piece *p)
 {
-    return ldexp(mesh->longest[p->tri], -(int)p->level);
+    return ldexp(mesh->longest[p->tri] / (double)s->seed_m[p->tri], -(int)p->level);
+}
+
+static unsigned lattice_bits(uint64_t m)
+{
+    unsigned b = 0;
+    while (m) b++, m >>= 1;
+    return b;
 }
 
 /* r at a point of live triangle k (parameters uv, position x). */
@@ -164,19 +181,15 @@ static int splittable(const vpdsi_surface_ctx *ctx, const vpdsi_surface *s, cons
                       double r_hi)
 {
     double reach = s->t * ctx->coverage * r_hi;
-    return p->level < PIECE_MAX_LEVEL && piece_edge(ctx->mesh, p) >= 2 * ctx->mesh->min_edge &&
-           piece_area(ctx->mesh, p) >= MIN_AREA_FRACTION * reach * reach;
+    return p->level + lattice_bits(s->seed_m[p->tri]) < PIECE_MAX_LEVEL &&
+           piece_edge(s, ctx->mesh, p) >= 2 * ctx->mesh->min_edge &&
+           piece_area(s, ctx->mesh, p) >= MIN_AREA_FRACTION * reach * reach;
 }
 
 /* ---- coverage ---- */
 
-/* The samples that may conflict with or cover a point of the piece (corners x, r <= r_hi). */
-static vpds_status gather_piece_near(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, double x[3][3],
-                               double r_hi)
+static void corners_box(double x[3][3], double *lo, double *hi)
 {
-    vpdsi_store *st = ctx->st;
-    vpdsi_kd_samples v = vpdsi_store_view(st);
-    double lo[3], hi[3];
     int k, q;
     for (k = 0; k < 3; k++) {
         lo[k] = hi[k] = x[0][k];
@@ -185,33 +198,69 @@ static vpds_status gather_piece_near(vpdsi_surface *s, const vpdsi_surface_ctx *
             if (x[q][k] > hi[k]) hi[k] = x[q][k];
         }
     }
-    s->n_near = 0;
-    if (vpdsi_kd_near_box(&st->tree, &v, lo, hi, r_hi, s->t * ctx->coverage, 0, SIZE_MAX, st->mem,
-                          &s->near, &s->n_near, &s->cap_near) < 0) {
-        vpdsi_store_error(st, "out of memory for a list of %zu samples near a piece", s->n_near);
-        return VPDS_ERR_OUT_OF_MEMORY;
+}
+
+/* The samples that may conflict with or cover a point of the piece (corners x, r <= r_hi,
+ * longest edge `edge`), into s->near: filtered from the cached list of a box around recent
+ * pieces when that box holds this one (the samples do not change during a sweep), else from a
+ * new search of a box two edges wider on every side, which the next pieces (siblings, or the
+ * rest of a row of seed pieces) then share. */
+static vpds_status piece_near(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, double x[3][3],
+                              double r_hi, double edge)
+{
+    vpdsi_store *st = ctx->st;
+    vpdsi_kd_samples v = vpdsi_store_view(st);
+    double lo[3], hi[3], scale = s->t * ctx->coverage;
+    int k, inside = s->cache_ok && r_hi <= s->cache_r;
+    corners_box(x, lo, hi);
+    for (k = 0; k < 3 && inside; k++) inside = lo[k] >= s->cache_lo[k] && hi[k] <= s->cache_hi[k];
+    if (!inside) {
+        s->cache_ok = 0;
+        s->n_cache = 0;
+        for (k = 0; k < 3; k++) {
+            s->cache_lo[k] = lo[k] - 2 * edge;
+            s->cache_hi[k] = hi[k] + 2 * edge;
+        }
+        s->cache_r = ctx->mesh->vr || st->sizing.kind != VPDSI_SIZING_CONSTANT ? 1.25 * r_hi : r_hi;
+        if (vpdsi_kd_near_box(&st->tree, &v, s->cache_lo, s->cache_hi, s->cache_r, scale, 0, SIZE_MAX,
+                              st->mem, &s->cache, &s->n_cache, &s->cap_cache) < 0 ||
+            vpdsi_mem_reserve(st->mem, (void **)&s->near, &s->cap_near, s->n_cache, sizeof *s->near)) {
+            vpdsi_store_error(st, "out of memory for a list of %zu samples near a piece", s->n_cache);
+            return VPDS_ERR_OUT_OF_MEMORY;
+        }
+        s->cache_ok = 1;
     }
+    s->n_near = vpdsi_kd_filter_near(&st->tree, &v, s->cache, s->n_cache, lo, hi, r_hi, scale, 0, s->near);
     return VPDS_OK;
 }
 
-/* Whether one candidate holds the three corners in its disk at r_lo: then the whole piece, the
- * disk being convex and f non-decreasing in r(y) (Table 2's BiX/XiB on a triangle). */
-static int corners_covered(const vpdsi_surface *s, const vpdsi_surface_ctx *ctx, double x[3][3],
-                           double r_lo)
+/* Whether sample i holds the three corners in its disk at r_lo: then the whole piece, the disk
+ * being convex and f non-decreasing in r(y) (Table 2's BiX/XiB on a triangle). */
+static int holds_corners(const vpdsi_surface *s, const vpdsi_surface_ctx *ctx, int32_t i,
+                         double x[3][3], double r_lo)
 {
     const vpdsi_store *st = ctx->st;
-    double scale = s->t * ctx->coverage;
-    size_t n;
-    for (n = 0; n < s->n_near; n++) {
-        const double *c = st->x + 3 * (size_t)s->near[n];
-        double f = scale * vpdsi_rule_f(ctx->rule, st->r[s->near[n]], r_lo), f2 = f * f;
-        int q, ok = 1;
-        for (q = 0; q < 3 && ok; q++) {
-            double d0 = x[q][0] - c[0], d1 = x[q][1] - c[1], d2 = x[q][2] - c[2];
-            ok = d0 * d0 + d1 * d1 + d2 * d2 <= f2;
-        }
-        if (ok) return 1;
+    const double *c = st->x + 3 * (size_t)i;
+    double f = s->t * ctx->coverage * vpdsi_rule_f(ctx->rule, st->r[i], r_lo), f2 = f * f;
+    int q;
+    for (q = 0; q < 3; q++) {
+        double d0 = x[q][0] - c[0], d1 = x[q][1] - c[1], d2 = x[q][2] - c[2];
+        if (d0 * d0 + d1 * d1 + d2 * d2 > f2) return 0;
     }
+    return 1;
+}
+
+/* Whether one sample of the near list holds the piece; the one found is tried first for the
+ * next piece (neighbours are mostly held by the same disk). */
+static int corners_covered(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, double x[3][3],
+                           double r_lo)
+{
+    size_t n;
+    for (n = 0; n < s->n_near; n++)
+        if (holds_corners(s, ctx, s->near[n], x, r_lo)) {
+            s->last_cover = s->near[n];
+            return 1;
+        }
     return 0;
 }
 
@@ -227,129 +276,162 @@ static vpds_status reserve_pieces(vpdsi_mem *m, vpdsi_piece **p, size_t *cap, si
     return VPDS_OK;
 }
 
-/* Seed pieces no wider than the smallest covering disk over them: ceil(log2) levels of a
- * triangle at a known r_min; with a callback r_min is unknown and nothing is refused here. */
-static vpds_status check_seed_count(vpdsi_surface *s, const vpdsi_surface_ctx *ctx)
+/* r over live triangle k as the seed lattice sees it: exact bounds for a constant and vertex
+ * radii, r at the centroid for a sizing (seed pieces only need to be about a disk wide: a piece
+ * too large for one disk is split by the sweep like any other). */
+static vpds_status seed_radius(const vpdsi_surface_ctx *ctx, uint32_t k, double *r)
 {
     const vpdsi_trimesh *mesh = ctx->mesh;
-    const vpdsi_store *st = ctx->st;
-    double total = 0;
+    const uint32_t *t = mesh->tri + 3 * (size_t)mesh->live[k];
+    double uv[2] = {1.0 / 3, 1.0 / 3}, c[3];
+    int q;
+    if (mesh->vr) {
+        for (*r = INFINITY, q = 0; q < 3; q++) *r = mesh->vr[t[q]] < *r ? mesh->vr[t[q]] : *r;
+        return VPDS_OK;
+    }
+    if (ctx->st->sizing.kind == VPDSI_SIZING_CONSTANT) {
+        *r = ctx->st->sizing.radius;
+        return VPDS_OK;
+    }
+    for (q = 0; q < 3; q++)
+        c[q] = (mesh->v[3 * (size_t)t[0] + q] + mesh->v[3 * (size_t)t[1] + q] + mesh->v[3 * (size_t)t[2] + q]) / 3;
+    return radius_on(ctx, k, uv, c, r);
+}
+
+/* Index the samples for the darts' conflict queries: the octave grid when the largest radius is
+ * known (the kd-tree, synced before each sweep, answers the sweeps' near queries). */
+static vpds_status choose_sample_index(const vpdsi_surface *s, const vpdsi_surface_ctx *ctx)
+{
+    vpdsi_store *st = ctx->st;
+    double top = 0;
     size_t k;
-    if (!mesh->vr && st->sizing.kind != VPDSI_SIZING_CONSTANT) return VPDS_OK;
-    for (k = 0; k < mesh->n_live && total <= SEED_COUNT_MAX; k++) {
-        const uint32_t *t = mesh->tri + 3 * (size_t)mesh->live[k];
-        double r = st->sizing.radius, ratio;
-        int q;
-        if (mesh->vr)
-            for (r = INFINITY, q = 0; q < 3; q++) r = mesh->vr[t[q]] < r ? mesh->vr[t[q]] : r;
-        ratio = mesh->longest[k] / (s->t * ctx->coverage * r);
-        if (ratio > 1) total += pow(4.0, ceil(log2(ratio)));
-        else total += 1;
+    vpds_status e = vpdsi_store_use_tree(st);
+    if (e != VPDS_OK) return e;
+    if (ctx->mesh->vr) {
+        for (k = 0; k < ctx->mesh->n_vertices; k++) top = ctx->mesh->vr[k] > top ? ctx->mesh->vr[k] : top;
+    } else if (st->sizing.kind == VPDSI_SIZING_CONSTANT) {
+        top = st->sizing.radius;
     }
-    if (total > SEED_COUNT_MAX) {
-        vpdsi_store_error(ctx->st, "scale t = %g: the mesh needs more than %.0f pieces of the size of "
-                          "a disk (the radius is too small for its triangles); the count overflows",
-                          s->t, SEED_COUNT_MAX);
-        return VPDS_ERR_OVERFLOW;
-    }
-    s->seed_checked = 1;
-    return VPDS_OK;
+    return top > 0 ? vpdsi_store_use_ogrid(st, s->t * ctx->coverage * top) : VPDS_OK;
 }
 
-/* Live triangle s->pos split until each piece lies within one disk of its smallest radius,
- * depth first; on failure the triangle leaves nothing. *done: pieces made. */
-static vpds_status seed_triangle(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, uint64_t *done)
+static void begin_piece_darts(vpdsi_surface *s, double per_piece, double pieces)
 {
-    vpdsi_piece stack[4 * (PIECE_MAX_LEVEL + 2)];
-    size_t top = 0, first = s->n_cur;
-    vpds_status e = VPDS_OK;
-    memset(&stack[0], 0, sizeof stack[0]);
-    stack[top++].tri = (uint32_t)s->pos;
-    while (top) {
-        vpdsi_piece p = stack[--top];
-        double uv[3][2], x[3][3], r_lo, r_hi;
-        int q;
-        piece_corners(ctx->mesh, &p, uv, x);
-        if ((e = piece_bounds(ctx, &p, uv, x, &r_lo, &r_hi)) != VPDS_OK) break;
-        if (piece_edge(ctx->mesh, &p) > s->t * ctx->coverage * r_lo && splittable(ctx, s, &p, r_hi)) {
-            for (q = 3; q >= 0; q--) stack[top++] = child_of(&p, q);
-            continue;
-        }
-        if ((e = reserve_pieces(ctx->st->mem, &s->cur, &s->cap_cur, s->n_cur + 1, ctx->st)) != VPDS_OK)
-            break;
-        s->cur[s->n_cur++] = p;
-        if (p.level + 1u > ctx->stats->levels) ctx->stats->levels = p.level + 1u;
-        (*done)++;
-    }
-    if (e != VPDS_OK) {
-        s->n_cur = first;
-        return e;
-    }
-    s->pos++;
-    return VPDS_OK;
-}
-
-static void begin_darts(vpdsi_surface *s, double per_piece)
-{
-    double n = ceil(per_piece * (double)s->n_cur);
+    double n = ceil(per_piece * pieces);
     s->phase = VPDSI_SURF_DARTS;
     s->darts_left = n < 1 ? 1 : (uint64_t)n;
     s->cum_ready = 0;
 }
 
+static void begin_piece_sweep(vpdsi_surface *s, vpdsi_surf_phase phase)
+{
+    s->phase = phase;
+    s->pos = 0;
+    s->ipos = 0;
+    s->ctri = 0;
+    s->crow = s->cpos = 0;
+    s->split_any = 0;
+    s->cache_ok = 0; /* new samples since the last sweep */
+    s->last_cover = -1;
+}
+
+/* The seed lattice of each live triangle: m = ceil(longest edge / (t * coverage * r)) pieces
+ * per edge. Chunks of triangles; a sizing failure leaves the triangle for the retry. */
 static vpds_status seed_step(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, uint64_t limit,
                              uint64_t *done)
 {
+    const vpdsi_trimesh *mesh = ctx->mesh;
+    vpdsi_mem *mem = ctx->st->mem;
     vpds_status e;
-    if (!s->seed_checked && (e = check_seed_count(s, ctx)) != VPDS_OK) return e;
-    while (s->pos < ctx->mesh->n_live && *done < limit)
-        if ((e = seed_triangle(s, ctx, done)) != VPDS_OK) return e;
-    if (s->pos < ctx->mesh->n_live) return VPDS_OK;
-    if (s->n_cur > ctx->stats->peak_active_cells) ctx->stats->peak_active_cells = s->n_cur;
-    s->pos = 0;
+    if (s->pos == 0) {
+        if (vpdsi_mem_reserve(mem, (void **)&s->seed_m, &s->cap_seed_m, mesh->n_live, sizeof *s->seed_m) ||
+            vpdsi_mem_reserve(mem, (void **)&s->tri_cum, &s->cap_tri_cum, mesh->n_live, sizeof *s->tri_cum)) {
+            vpdsi_store_error(ctx->st, "out of memory for the seed lattices of %zu triangles", mesh->n_live);
+            return VPDS_ERR_OUT_OF_MEMORY;
+        }
+        s->seed_total = 0;
+    }
+    for (; s->pos < mesh->n_live && *done < limit; s->pos++, (*done)++) {
+        double r, ratio, m;
+        if ((e = seed_radius(ctx, (uint32_t)s->pos, &r)) != VPDS_OK) return e;
+        ratio = mesh->longest[s->pos] / (s->t * ctx->coverage * r);
+        m = ratio > 1 ? ceil(ratio) : 1;
+        if (!(m <= SEED_EDGE_MAX) || (double)s->seed_total + m * m > SEED_COUNT_MAX) {
+            vpdsi_store_error(ctx->st, "scale t = %g: triangle %u needs %.3g pieces of the size of a disk "
+                              "(the mesh needs more than %.0f in all, or the radius is too small for "
+                              "its triangles); the count overflows", s->t, (unsigned)mesh->live[s->pos],
+                              m * m, SEED_COUNT_MAX);
+            s->pos = 0;
+            return VPDS_ERR_OVERFLOW;
+        }
+        s->seed_m[s->pos] = (uint64_t)m;
+        s->seed_total += (uint64_t)m * (uint64_t)m;
+        s->tri_cum[s->pos] = (s->pos ? s->tri_cum[s->pos - 1] : 0) + mesh->area[s->pos];
+    }
+    if (s->pos < mesh->n_live) return VPDS_OK;
+    if ((e = choose_sample_index(s, ctx)) != VPDS_OK) return e;
+    if (s->seed_total > ctx->stats->peak_active_cells) ctx->stats->peak_active_cells = s->seed_total;
+    if (ctx->stats->levels < 1) ctx->stats->levels = 1;
+    s->implicit = 1;
     if (ctx->st->n > 0) {
-        s->phase = VPDSI_SURF_FILTER; /* a refinement: the earlier samples cover much already */
-        s->split_any = 0;
+        /* a refinement: the earlier samples cover much of the surface already */
+        if ((e = vpdsi_store_sync_tree(ctx->st)) != VPDS_OK) return e;
+        begin_piece_sweep(s, VPDSI_SURF_FILTER);
     } else {
-        begin_darts(s, DARTS_PER_SEED_PIECE);
+        begin_piece_darts(s, DARTS_PER_SEED_PIECE, (double)s->seed_total);
     }
     return VPDS_OK;
 }
 
-/* The dart: a piece by area (binary search of the running sums), then a uniform point of it
- * (the unit square folded onto the triangle). */
-static void draw_dart(const vpdsi_surface *s, const vpdsi_surface_ctx *ctx, vpdsi_piece *p,
-                      double *uv, double *x)
+static size_t search_running_sums(const double *cum, size_t n, double u)
 {
-    double total = s->cum[s->n_cur - 1], u = vpdsi_rng_unit(ctx->rng) * total, a, b;
-    size_t lo = 0, hi = s->n_cur - 1;
+    size_t lo = 0, hi = n - 1;
     while (lo < hi) {
         size_t mid = lo + (hi - lo) / 2;
-        if (s->cum[mid] > u) hi = mid; else lo = mid + 1;
+        if (cum[mid] > u) hi = mid; else lo = mid + 1;
     }
-    *p = s->cur[lo];
+    return lo;
+}
+
+/* The dart: a piece by area (binary search of the running sums; over the seed pieces, a
+ * triangle by area), then a uniform point of it (the unit square folded onto the triangle). */
+static void draw_piece_dart(const vpdsi_surface *s, const vpdsi_surface_ctx *ctx, uint32_t *tri,
+                      double *uv, double *x)
+{
+    const vpdsi_trimesh *mesh = ctx->mesh;
+    vpdsi_piece p;
+    double a, b, scale;
+    const uint32_t *t;
+    const double *va, *vb, *vc;
+    int q;
+    if (s->implicit) {
+        memset(&p, 0, sizeof p);
+        p.tri = (uint32_t)search_running_sums(s->tri_cum, mesh->n_live,
+                                      vpdsi_rng_unit(ctx->rng) * s->tri_cum[mesh->n_live - 1]);
+        scale = 1;
+    } else {
+        p = s->cur[search_running_sums(s->cum, s->n_cur, vpdsi_rng_unit(ctx->rng) * s->cum[s->n_cur - 1])];
+        scale = ldexp(1.0 / (double)s->seed_m[p.tri], -(int)p.level);
+    }
     a = vpdsi_rng_unit(ctx->rng);
     b = vpdsi_rng_unit(ctx->rng);
     if (a + b > 1) {
         a = 1 - a;
         b = 1 - b;
     }
-    if (p->down) {
+    if (p.down) {
         a = 1 - a;
         b = 1 - b;
     }
-    uv[0] = ldexp((double)p->i + a, -(int)p->level);
-    uv[1] = ldexp((double)p->j + b, -(int)p->level);
-    {
-        const uint32_t *t = ctx->mesh->tri + 3 * (size_t)ctx->mesh->live[p->tri];
-        const double *va = ctx->mesh->v + 3 * (size_t)t[0], *vb = ctx->mesh->v + 3 * (size_t)t[1];
-        const double *vc = ctx->mesh->v + 3 * (size_t)t[2];
-        int q;
-        for (q = 0; q < 3; q++) x[q] = va[q] + uv[0] * (vb[q] - va[q]) + uv[1] * (vc[q] - va[q]);
-    }
+    *tri = p.tri;
+    uv[0] = s->implicit ? a : ((double)p.i + a) * scale;
+    uv[1] = s->implicit ? b : ((double)p.j + b) * scale;
+    t = mesh->tri + 3 * (size_t)mesh->live[p.tri];
+    va = mesh->v + 3 * (size_t)t[0], vb = mesh->v + 3 * (size_t)t[1], vc = mesh->v + 3 * (size_t)t[2];
+    for (q = 0; q < 3; q++) x[q] = va[q] + uv[0] * (vb[q] - va[q]) + uv[1] * (vc[q] - va[q]);
 }
 
-static vpds_status reserve_samples(vpdsi_surface *s, vpdsi_store *st, size_t more)
+static vpds_status reserve_surface_samples(vpdsi_surface *s, vpdsi_store *st, size_t more)
 {
     vpds_status e = vpdsi_store_reserve(st, more);
     size_t need = st->n + more;
@@ -362,7 +444,7 @@ static vpds_status reserve_samples(vpdsi_surface *s, vpdsi_store *st, size_t mor
     return VPDS_OK;
 }
 
-static vpds_status build_sums(vpdsi_surface *s, const vpdsi_surface_ctx *ctx)
+static vpds_status build_piece_sums(vpdsi_surface *s, const vpdsi_surface_ctx *ctx)
 {
     double sum = 0;
     size_t k;
@@ -370,36 +452,36 @@ static vpds_status build_sums(vpdsi_surface *s, const vpdsi_surface_ctx *ctx)
         vpdsi_store_error(ctx->st, "out of memory for the areas of %zu pieces", s->n_cur);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
-    for (k = 0; k < s->n_cur; k++) s->cum[k] = sum += piece_area(ctx->mesh, &s->cur[k]);
+    for (k = 0; k < s->n_cur; k++) s->cum[k] = sum += piece_area(s, ctx->mesh, &s->cur[k]);
     s->cum_ready = 1;
     return VPDS_OK;
 }
 
 /* A chunk of darts (Eq. 4: kept when no sample conflicts). A failed sizing value restores the
- * rng to the failing dart, so the retry throws it again. */
+ * rng to the failing dart, so the retry throws it again. Before the sweep, the kd-tree catches
+ * up with the samples the octave grid took. */
 static vpds_status piece_darts_step(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, uint64_t limit,
-                              uint64_t *done)
+                                    uint64_t *done)
 {
     vpdsi_store *st = ctx->st;
     int callback = !ctx->mesh->vr && st->sizing.kind != VPDSI_SIZING_CONSTANT;
     double scale = s->t * ctx->coverage;
     vpds_status e;
     if (s->darts_left == 0) {
-        s->phase = VPDSI_SURF_SWEEP;
-        s->pos = 0;
-        s->split_any = 0;
+        if ((e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
+        begin_piece_sweep(s, VPDSI_SURF_SWEEP);
         return VPDS_OK;
     }
-    if (!s->cum_ready && (e = build_sums(s, ctx)) != VPDS_OK) return e;
+    if (!s->implicit && !s->cum_ready && (e = build_piece_sums(s, ctx)) != VPDS_OK) return e;
     if (s->darts_left < limit) limit = s->darts_left;
-    if ((e = reserve_samples(s, st, (size_t)limit)) != VPDS_OK) return e;
+    if ((e = reserve_surface_samples(s, st, (size_t)limit)) != VPDS_OK) return e;
     while (*done < limit) {
         vpdsi_rng before = *ctx->rng;
-        vpdsi_piece p;
+        uint32_t tri;
         double uv[2], x[3], r;
         int32_t witness = -1, hit;
-        draw_dart(s, ctx, &p, uv, x);
-        if ((e = radius_on(ctx, p.tri, uv, x, &r)) != VPDS_OK) {
+        draw_piece_dart(s, ctx, &tri, uv, x);
+        if ((e = radius_on(ctx, tri, uv, x, &r)) != VPDS_OK) {
             *ctx->rng = before;
             return e;
         }
@@ -413,7 +495,7 @@ static vpds_status piece_darts_step(vpdsi_surface *s, const vpdsi_surface_ctx *c
         s->darts_left--;
         ctx->stats->darts++;
         if (hit != -1) continue;
-        s->face[st->n] = ctx->mesh->live[p.tri];
+        s->face[st->n] = ctx->mesh->live[tri];
         s->bary[3 * st->n] = 1 - uv[0] - uv[1];
         s->bary[3 * st->n + 1] = uv[0];
         s->bary[3 * st->n + 2] = uv[1];
@@ -425,15 +507,16 @@ static vpds_status piece_darts_step(vpdsi_surface *s, const vpdsi_surface_ctx *c
 
 /* One piece of a sweep: dropped when covered, else its uncovered children (split) or itself
  * into next (reserved by the caller for four). */
-static vpds_status sweep_piece(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, const vpdsi_piece *p,
+static vpds_status sweep_one_piece(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, const vpdsi_piece *p,
                                int split)
 {
     double uv[3][2], x[3][3], r_lo, r_hi;
     vpds_status e;
     int q;
-    piece_corners(ctx->mesh, p, uv, x);
+    piece_corners(s, ctx->mesh, p, uv, x);
     if ((e = piece_bounds(ctx, p, uv, x, &r_lo, &r_hi)) != VPDS_OK) return e;
-    if ((e = gather_piece_near(s, ctx, x, r_hi)) != VPDS_OK) return e;
+    if (s->last_cover >= 0 && holds_corners(s, ctx, s->last_cover, x, r_lo)) return VPDS_OK;
+    if ((e = piece_near(s, ctx, x, r_hi, piece_edge(s, ctx->mesh, p))) != VPDS_OK) return e;
     if (corners_covered(s, ctx, x, r_lo)) return VPDS_OK;
     if (!split || !splittable(ctx, s, p, r_hi)) {
         s->next[s->n_next++] = *p;
@@ -443,7 +526,7 @@ static vpds_status sweep_piece(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, c
     for (q = 0; q < 4; q++) {
         vpdsi_piece c = child_of(p, q);
         double cuv[3][2], cx[3][3], c_lo = r_lo, c_hi = r_hi;
-        piece_corners(ctx->mesh, &c, cuv, cx);
+        piece_corners(s, ctx->mesh, &c, cuv, cx);
         /* a child lies in its parent: the parent's bounds hold, vertex radii's exact ones are
          * tighter */
         if (ctx->mesh->vr && (e = piece_bounds(ctx, &c, cuv, cx, &c_lo, &c_hi)) != VPDS_OK) return e;
@@ -451,6 +534,29 @@ static vpds_status sweep_piece(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, c
         if (c.level + 1u > ctx->stats->levels) ctx->stats->levels = c.level + 1u;
     }
     return VPDS_OK;
+}
+
+/* The seed piece at the implicit sweep's cursor: row crow of triangle ctri has 2 (m - row) - 1
+ * pieces, up and down in turn. */
+static vpdsi_piece seed_cursor_piece(const vpdsi_surface *s)
+{
+    vpdsi_piece p;
+    memset(&p, 0, sizeof p);
+    p.tri = (uint32_t)s->ctri;
+    p.j = s->crow;
+    p.i = s->cpos >> 1;
+    p.down = (uint8_t)(s->cpos & 1);
+    return p;
+}
+
+static void advance_seed_cursor(vpdsi_surface *s)
+{
+    uint64_t m = s->seed_m[s->ctri];
+    if (++s->cpos < 2 * (m - s->crow) - 1) return;
+    s->cpos = 0;
+    if (++s->crow < m) return;
+    s->crow = 0;
+    s->ctri++;
 }
 
 /* The sweep is over: its pieces become the active ones; the run ends when none is left, or when
@@ -468,6 +574,7 @@ static void finish_piece_sweep(vpdsi_surface *s, const vpdsi_surface_ctx *ctx)
     s->n_next = 0;
     s->pos = 0;
     s->cum_ready = 0;
+    s->implicit = 0;
     if (s->n_cur > ctx->stats->peak_active_cells) ctx->stats->peak_active_cells = s->n_cur;
     if (s->n_cur == 0) {
         ctx->stats->delta = 0;
@@ -475,34 +582,44 @@ static void finish_piece_sweep(vpdsi_surface *s, const vpdsi_surface_ctx *ctx)
     } else if (!was_filter && !s->split_any) {
         double worst = 0;
         for (k = 0; k < s->n_cur; k++)
-            if (piece_edge(ctx->mesh, &s->cur[k]) > worst) worst = piece_edge(ctx->mesh, &s->cur[k]);
+            if (piece_edge(s, ctx->mesh, &s->cur[k]) > worst) worst = piece_edge(s, ctx->mesh, &s->cur[k]);
         ctx->stats->delta = worst;
         s->phase = VPDSI_SURF_DONE;
     } else {
-        begin_darts(s, was_filter ? DARTS_PER_SEED_PIECE : DARTS_PER_PIECE);
+        begin_piece_darts(s, was_filter ? DARTS_PER_SEED_PIECE : DARTS_PER_PIECE, (double)s->n_cur);
     }
-    if (s->phase == VPDSI_SURF_DONE) release_pieces(s, ctx->st->mem);
+    if (s->phase == VPDSI_SURF_DONE) {
+        release_pieces(s, ctx->st->mem);
+        vpdsi_store_drop_index(ctx->st); /* the kd-tree holds every sample: synced for the sweep */
+    }
 }
 
 static vpds_status piece_sweep_step(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, uint64_t limit,
-                              uint64_t *done)
+                                    uint64_t *done)
 {
     int split = s->phase == VPDSI_SURF_SWEEP;
+    uint64_t left = s->implicit ? s->seed_total - s->ipos : s->n_cur - s->pos;
     vpds_status e;
-    if (s->n_cur - s->pos < limit) limit = s->n_cur - s->pos;
+    if (left < limit) limit = left;
     if ((e = reserve_pieces(ctx->st->mem, &s->next, &s->cap_next, s->n_next + 4 * (size_t)limit,
                             ctx->st)) != VPDS_OK)
         return e;
     while (*done < limit) {
         size_t kept = s->n_next;
-        if ((e = sweep_piece(s, ctx, &s->cur[s->pos], split)) != VPDS_OK) {
+        vpdsi_piece p = s->implicit ? seed_cursor_piece(s) : s->cur[s->pos];
+        if ((e = sweep_one_piece(s, ctx, &p, split)) != VPDS_OK) {
             s->n_next = kept;
             return e;
         }
-        s->pos++;
+        if (s->implicit) {
+            advance_seed_cursor(s);
+            s->ipos++;
+        } else {
+            s->pos++;
+        }
         (*done)++;
     }
-    if (s->pos == s->n_cur) finish_piece_sweep(s, ctx);
+    if (s->implicit ? s->ipos == s->seed_total : s->pos == s->n_cur) finish_piece_sweep(s, ctx);
     return VPDS_OK;
 }
 
@@ -511,7 +628,7 @@ static int surface_progress_stops(const vpdsi_surface *s, const vpdsi_surface_ct
     vpds_progress p;
     p.darts = ctx->stats->darts;
     p.samples = ctx->st->n;
-    p.active_cells = s->phase == VPDSI_SURF_DONE ? 0 : s->n_cur;
+    p.active_cells = s->phase == VPDSI_SURF_DONE ? 0 : s->implicit ? s->seed_total : s->n_cur;
     p.level = ctx->stats->levels;
     p.t = s->t;
     return ctx->progress(&p, ctx->progress_user) != 0;

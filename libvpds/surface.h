@@ -14,6 +14,7 @@ typedef struct vpdsi_trimesh {
     const double *v;          /* vertices, 3 doubles each */
     const uint32_t *tri;      /* 3 vertex indices per triangle */
     const double *vr;         /* per-vertex radii (NULL: the store's sizing) */
+    size_t n_vertices;
     const uint32_t *live;     /* the triangles with area, ascending */
     const double *area;       /* per live triangle */
     const double *longest;    /* per live triangle: its longest edge */
@@ -21,9 +22,10 @@ typedef struct vpdsi_trimesh {
     double min_edge;          /* 2^-44 of the coordinates' magnitude: no piece splits below */
 } vpdsi_trimesh;
 
-/* A piece: lattice triangle (i, j) of triangle live[tri] split `level` times, pointing up
- * (corners (i,j), (i+1,j), (i,j+1) in units of 2^-level along its two edges) or down (corners
- * (i+1,j), (i,j+1), (i+1,j+1)). */
+/* A piece: lattice triangle (i, j) of live triangle `tri` cut into m x m seed pieces (m of the
+ * triangle, chosen per scale so that a seed piece lies within one disk) and split `level` times
+ * more, pointing up (corners (i,j), (i+1,j), (i,j+1) in units of 1 / (m 2^level) along its two
+ * edges) or down (corners (i+1,j), (i,j+1), (i+1,j+1)). */
 typedef struct vpdsi_piece {
     uint64_t i, j;
     uint32_t tri;
@@ -39,12 +41,23 @@ typedef enum {
 typedef struct vpdsi_surface {
     vpdsi_surf_phase phase;
     double t;                            /* scale being sampled */
+    uint64_t *seed_m;                    /* per live triangle: m, its seed pieces per edge */
+    double *tri_cum;                     /* running sums of the live triangles' areas */
+    size_t cap_seed_m, cap_tri_cum;
+    uint64_t seed_total;                 /* seed pieces in all: sum of m^2 */
+    int implicit;                        /* the active pieces are all the seed pieces (level 0,
+                                            never stored: darts land uniform on the surface) */
+    size_t ctri; uint64_t crow, cpos;    /* implicit sweep: triangle, row, place in the row */
+    int32_t *cache; size_t n_cache, cap_cache; /* samples near a box around recent pieces */
+    double cache_lo[3], cache_hi[3], cache_r;
+    int cache_ok;
+    int32_t last_cover;                  /* the sample that held the last covered piece */
     vpdsi_piece *cur, *next;             /* active pieces, and those of the next level */
     size_t n_cur, cap_cur, n_next, cap_next;
     double *cum;  size_t cap_cum;        /* running sums of the active pieces' areas */
     int cum_ready;                       /* cum holds this level's sums */
-    int seed_checked;                    /* the seed count was found within bounds */
     size_t pos;                          /* seed: next live triangle; sweeps: next piece */
+    uint64_t ipos;                       /* implicit sweep: seed pieces done */
     uint64_t darts_left;
     int split_any;                       /* the sweep split a piece (else the run ends) */
     int32_t *near; size_t n_near, cap_near;
