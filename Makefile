@@ -250,6 +250,7 @@ $(BUILD)/bench/bench: bench/bench.c $(STATIC)
 bench: $(BUILD)/bench/bench $(DEPS_STAMP) $(VENV)/.vpds-installed
 	$(PY) bench/run.py $(BENCH_ARGS)
 	$(PY) bench/tiled.py $(if $(findstring --quick,$(BENCH_ARGS)),--quick)
+	$(PY) bench/mesh.py $(if $(findstring --quick,$(BENCH_ARGS)),--quick)
 
 deps: $(DEPS_STAMP)
 

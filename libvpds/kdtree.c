@@ -347,15 +347,7 @@ static double near_limit(double r, double r_bound, double scale, double slack)
 static int is_near(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i, const double *lo,
                    const double *hi, double r_bound, double scale, double slack)
 {
-    const double *x = s->x + (size_t)i * (size_t)t->dim;
-    double lim = near_limit(s->r[i], r_bound, scale, slack), lim2 = lim * lim, g2 = 0;
-    int k;
-    for (k = 0; k < t->dim; k++) {
-        double e = vpdsi_axis_gap(x[k], lo[k], hi[k], t->period[k]);
-        g2 += e * e;
-        if (g2 > lim2) return 0; /* the sum only grows */
-    }
-    return 1;
+    return vpdsi_prox_near(s, i, t->dim, t->period, lo, hi, r_bound, scale, slack);
 }
 
 int vpdsi_kd_near_box(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *lo,

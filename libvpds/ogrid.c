@@ -318,3 +318,32 @@ int vpdsi_ogrid_gather(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const do
     }
     return 0;
 }
+
+int vpdsi_ogrid_near_box(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const double *lo,
+                         const double *hi, double r_bound, double scale, vpdsi_mem *m,
+                         int32_t **out, size_t *count, size_t *cap)
+{
+    int l;
+    for (l = 0; l < g->levels; l++) {
+        uint64_t a[3], b[3], c[3];
+        size_t pos = 0;
+        int32_t i;
+        int scan;
+        double reach;
+        if (g->lv[l].count == 0) continue;
+        /* the widest of the level's samples' tests, as vpdsi_prox_near widens it */
+        reach = scale * (g->lv[l].rmax > r_bound ? g->lv[l].rmax : r_bound) * (1 + 1e-9);
+        if (!cell_range(g, l, lo, hi, reach, a, b)) continue;
+        scan = range_cells(g->dim, a, b) > (double)g->cap;
+        while (next_range_cell(g, l, a, b, scan, c, &pos, &i)) {
+            if (i < 0 || cell_beyond(g, l, c, lo, hi, reach)) continue;
+            for (; i >= 0; i = g->next[i]) {
+                if (!vpdsi_prox_near(s, i, g->dim, open_axes, lo, hi, r_bound, scale, 0)) continue;
+                if (*count == *cap && vpdsi_mem_reserve(m, (void **)out, cap, *count + 1, sizeof **out))
+                    return -1;
+                (*out)[(*count)++] = i;
+            }
+        }
+    }
+    return 0;
+}

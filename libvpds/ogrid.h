@@ -45,4 +45,9 @@ int32_t vpdsi_ogrid_conflict(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, co
 int vpdsi_ogrid_gather(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const double *lo,
                        const double *hi, double r_hi, int rule, double scale, int split,
                        vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap);
+/* vpdsi_kd_near_box on the grid, without a limit: every sample near the box, appended to *out
+ * (grown with m); -1 on OOM. */
+int vpdsi_ogrid_near_box(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const double *lo,
+                         const double *hi, double r_bound, double scale, vpdsi_mem *m,
+                         int32_t **out, size_t *count, size_t *cap);
 #endif

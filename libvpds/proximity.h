@@ -7,6 +7,23 @@
 #include "samples.h"
 #include "torus.h"
 
+/* Near (vpdsi_kd_near_box): |x - box| <= scale * max(r(x), r_bound) * (1 + 1e-9) + slack. */
+static inline int vpdsi_prox_near(const vpdsi_kd_samples *s, int32_t i, int dim, const double *period,
+                                  const double *lo, const double *hi, double r_bound, double scale,
+                                  double slack)
+{
+    const double *x = s->x + (size_t)i * (size_t)dim;
+    double r = s->r[i], lim = scale * (r > r_bound ? r : r_bound) * (1 + 1e-9) + slack;
+    double lim2 = lim * lim, g2 = 0;
+    int k;
+    for (k = 0; k < dim; k++) {
+        double e = vpdsi_axis_gap(x[k], lo[k], hi[k], period[k]);
+        g2 += e * e;
+        if (g2 > lim2) return 0; /* the sum only grows */
+    }
+    return 1;
+}
+
 /* Sample i against the dart y of radius ry: 1 when it conflicts (|y - x| < scale f), -2 when
  * (lipschitz >= 0) its radius follows the sizing and breaks |r(x) - ry| <= L |x - y|, else 0. */
 static inline int vpdsi_prox_conflict(const vpdsi_kd_samples *s, int32_t i, int dim,

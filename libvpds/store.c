@@ -174,6 +174,21 @@ int vpdsi_store_gather(const vpdsi_store *st, const double *lo, const double *hi
                            cap);
 }
 
+vpds_status vpdsi_store_near_box(vpdsi_store *st, const double *lo, const double *hi, double r_bound,
+                                 double scale, int32_t **out, size_t *count, size_t *cap)
+{
+    vpdsi_kd_samples v = vpdsi_store_view(st);
+    int e = st->ogrid_mode
+                ? vpdsi_ogrid_near_box(&st->ogrid, &v, lo, hi, r_bound, scale, st->mem, out, count, cap)
+                : vpdsi_kd_near_box(&st->tree, &v, lo, hi, r_bound, scale, 0, SIZE_MAX, st->mem, out,
+                                    count, cap);
+    if (e < 0) {
+        vpdsi_store_error(st, "out of memory for a list of %zu samples near a box", *count);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    return VPDS_OK;
+}
+
 void vpdsi_store_append(vpdsi_store *st, const double *x, double r, double t, uint8_t flags)
 {
     memcpy(st->x + st->n * (size_t)st->dim, x, (size_t)st->dim * sizeof(double));

@@ -64,6 +64,10 @@ int32_t vpdsi_store_conflict(const vpdsi_store *st, const double *y, double ry, 
 int vpdsi_store_gather(const vpdsi_store *st, const double *lo, const double *hi, double r_hi,
                        int rule, double scale, int split, int32_t **out, size_t *count,
                        size_t *cap);
+/* vpdsi_kd_near_box without a limit on the index in use (kd-tree or octave grid): every sample
+ * near the box [lo, hi] appended to *out; VPDS_ERR_OUT_OF_MEMORY said in the sink. */
+vpds_status vpdsi_store_near_box(vpdsi_store *st, const double *lo, const double *hi, double r_bound,
+                                 double scale, int32_t **out, size_t *count, size_t *cap);
 /* Leave grid mode: the kd-tree takes over (it must hold every sample first). */
 vpds_status vpdsi_store_use_tree(vpdsi_store *st);
 /* Fixed points (vpds_add_points, after its checks): stored in the caller's order, each wrapped

@@ -212,6 +212,7 @@ static vpds_status piece_near(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, do
     vpdsi_kd_samples v = vpdsi_store_view(st);
     double lo[3], hi[3], scale = s->t * ctx->coverage;
     int k, inside = s->cache_ok && r_hi <= s->cache_r;
+    vpds_status e;
     corners_box(x, lo, hi);
     for (k = 0; k < 3 && inside; k++) inside = lo[k] >= s->cache_lo[k] && hi[k] <= s->cache_hi[k];
     if (!inside) {
@@ -222,9 +223,10 @@ static vpds_status piece_near(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, do
             s->cache_hi[k] = hi[k] + 2 * edge;
         }
         s->cache_r = ctx->mesh->vr || st->sizing.kind != VPDSI_SIZING_CONSTANT ? 1.25 * r_hi : r_hi;
-        if (vpdsi_kd_near_box(&st->tree, &v, s->cache_lo, s->cache_hi, s->cache_r, scale, 0, SIZE_MAX,
-                              st->mem, &s->cache, &s->n_cache, &s->cap_cache) < 0 ||
-            vpdsi_mem_reserve(st->mem, (void **)&s->near, &s->cap_near, s->n_cache, sizeof *s->near)) {
+        if ((e = vpdsi_store_near_box(st, s->cache_lo, s->cache_hi, s->cache_r, scale, &s->cache,
+                                      &s->n_cache, &s->cap_cache)) != VPDS_OK)
+            return e;
+        if (vpdsi_mem_reserve(st->mem, (void **)&s->near, &s->cap_near, s->n_cache, sizeof *s->near)) {
             vpdsi_store_error(st, "out of memory for a list of %zu samples near a piece", s->n_cache);
             return VPDS_ERR_OUT_OF_MEMORY;
         }
@@ -298,8 +300,7 @@ static vpds_status seed_radius(const vpdsi_surface_ctx *ctx, uint32_t k, double 
     return radius_on(ctx, k, uv, c, r);
 }
 
-/* Index the samples for the darts' conflict queries: the octave grid when the largest radius is
- * known (the kd-tree, synced before each sweep, answers the sweeps' near queries). */
+/* Index the samples: the octave grid when the largest radius is known, else the kd-tree. */
 static vpds_status choose_sample_index(const vpdsi_surface *s, const vpdsi_surface_ctx *ctx)
 {
     vpdsi_store *st = ctx->st;
@@ -375,7 +376,6 @@ static vpds_status seed_step(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, uin
     s->implicit = 1;
     if (ctx->st->n > 0) {
         /* a refinement: the earlier samples cover much of the surface already */
-        if ((e = vpdsi_store_sync_tree(ctx->st)) != VPDS_OK) return e;
         begin_piece_sweep(s, VPDSI_SURF_FILTER);
     } else {
         begin_piece_darts(s, DARTS_PER_SEED_PIECE, (double)s->seed_total);
@@ -458,8 +458,7 @@ static vpds_status build_piece_sums(vpdsi_surface *s, const vpdsi_surface_ctx *c
 }
 
 /* A chunk of darts (Eq. 4: kept when no sample conflicts). A failed sizing value restores the
- * rng to the failing dart, so the retry throws it again. Before the sweep, the kd-tree catches
- * up with the samples the octave grid took. */
+ * rng to the failing dart, so the retry throws it again. */
 static vpds_status piece_darts_step(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, uint64_t limit,
                                     uint64_t *done)
 {
@@ -468,7 +467,6 @@ static vpds_status piece_darts_step(vpdsi_surface *s, const vpdsi_surface_ctx *c
     double scale = s->t * ctx->coverage;
     vpds_status e;
     if (s->darts_left == 0) {
-        if ((e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
         begin_piece_sweep(s, VPDSI_SURF_SWEEP);
         return VPDS_OK;
     }
@@ -590,7 +588,7 @@ static void finish_piece_sweep(vpdsi_surface *s, const vpdsi_surface_ctx *ctx)
     }
     if (s->phase == VPDSI_SURF_DONE) {
         release_pieces(s, ctx->st->mem);
-        vpdsi_store_drop_index(ctx->st); /* the kd-tree holds every sample: synced for the sweep */
+        vpdsi_store_drop_index(ctx->st); /* the kd-tree catches up when next needed */
     }
 }
 

@@ -18,3 +18,16 @@ line=$("$out/quick")
 echo "$line" | grep -Eq '^[0-9]+ samples; the first at \(' \
   || { echo "readme_quickstart: unexpected output: $line" >&2; exit 1; }
 echo "summary: the README C quick start compiles with -Werror as C99 and as C++ and runs ($line)"
+# the surfaces' quick start: the first ```c block after "## Surfaces", the same way
+awk '/^## Surfaces/ {on = 1} on && /^```c$/ {grab = 1; next} grab && /^```$/ {exit}
+     grab {print}' README.md > "$out/mesh.c"
+[ -s "$out/mesh.c" ] || { echo "readme_quickstart: no C block under '## Surfaces'" >&2; exit 1; }
+${CC:-gcc} -std=c99 -Wall -Wextra -Wpedantic -Werror -Iinclude "$out/mesh.c" -o "$out/mesh" \
+  "$BUILD/libvpds.a" -lm -pthread
+${CXX:-g++} -Wall -Wextra -Wpedantic -Werror -Iinclude -x c++ "$out/mesh.c" -x none -o "$out/mesh_cxx" \
+  "$BUILD/libvpds.a" -lm -pthread
+line=$("$out/mesh")
+[ "$("$out/mesh_cxx")" = "$line" ] || { echo "readme_quickstart: the mesh C++ build prints otherwise" >&2; exit 1; }
+echo "$line" | grep -Eq '^[0-9]+ samples on the mesh; the first at \(.*\), triangle [01], barycentrics' \
+  || { echo "readme_quickstart: unexpected mesh output: $line" >&2; exit 1; }
+echo "summary: the README surfaces quick start compiles and runs ($line)"

@@ -77,6 +77,6 @@ def cmd_sample_mesh(args: argparse.Namespace) -> int:
     if args.plot:
         from .plots import plot_mesh
         plot_mesh(Path(args.plot), vertices, faces, s.points,
-                  f"{len(s.points)} samples on {Path(args.mesh).name}, {what}, rule {args.rule}")
+                  f"{len(s.points)} samples on {Path(args.mesh).name}, {what}, rule {args.rule}", radii=s.radii)
         print(f"wrote {args.plot}")
     return 0

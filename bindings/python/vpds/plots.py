@@ -521,9 +521,10 @@ def plot_analysis(path: Path, x: FloatArray, r: FloatArray, lo: FloatArray, hi: 
 
 
 def mesh_figure(vertices: FloatArray, faces: npt.NDArray[Any], points: FloatArray, title: str,
-                *, dpi: float = 150) -> Figure:
-    """The mesh as light shaded triangles and its samples as dots, in two views (front, and
-    turned half a turn) so that no side is hidden; the axes keep the mesh's proportions."""
+                *, radii: Optional[FloatArray] = None, dpi: float = 150) -> Figure:
+    """The mesh as light shaded triangles and its samples as dots (coloured by r when radii are
+    given and vary), in two views (front, and turned half a turn) so that no side is hidden;
+    the axes keep the mesh's proportions."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # type: ignore[import-untyped]
     fig = _new_figure(figsize=(12, 5.5), dpi=dpi, layout="constrained")
     v = np.asarray(vertices, dtype=float)
@@ -538,8 +539,11 @@ def mesh_figure(vertices: FloatArray, faces: npt.NDArray[Any], points: FloatArra
         ax = fig.add_subplot(1, 2, k + 1, projection="3d")
         ax.add_collection3d(Poly3DCollection(tris, facecolors=np.column_stack([shade] * 3 + [np.full(len(shade), 0.35)]),
                                              edgecolors=(0.5, 0.5, 0.5, 0.15), linewidths=0.2))
-        ax.scatter(points[:, 0], points[:, 1], points[:, 2], s=max(0.5, min(6.0, 6e4 / max(len(points), 1))),
-                   c="tab:red", depthshade=True, linewidths=0)
+        varying = radii is not None and len(radii) and float(np.ptp(radii)) > 0
+        dots = ax.scatter(points[:, 0], points[:, 1], points[:, 2], s=max(0.5, min(6.0, 6e4 / max(len(points), 1))),
+                          c=radii if varying else "tab:red", cmap="viridis", depthshade=True, linewidths=0)
+        if varying and k == 1:
+            fig.colorbar(dots, ax=ax, shrink=0.6, label="r")
         for setter, c, e in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, extent):
             setter(c - e / 2, c + e / 2)
         ax.set_box_aspect(tuple(float(e) for e in extent), zoom=1.3)
@@ -550,6 +554,6 @@ def mesh_figure(vertices: FloatArray, faces: npt.NDArray[Any], points: FloatArra
 
 
 def plot_mesh(path: Path, vertices: FloatArray, faces: npt.NDArray[Any], points: FloatArray,
-              title: str, *, dpi: float = 150) -> None:
+              title: str, *, radii: Optional[FloatArray] = None, dpi: float = 150) -> None:
     """Write mesh_figure(...) as a PNG at path."""
-    mesh_figure(vertices, faces, points, title, dpi=dpi).savefig(path, dpi=dpi)
+    mesh_figure(vertices, faces, points, title, radii=radii, dpi=dpi).savefig(path, dpi=dpi)
