@@ -59,131 +59,14 @@ void vpdsi_surface_begin(vpdsi_surface *s, double t)
     s->cum_ready = s->cache_ok = s->implicit = 0;
 }
 
-/* ---- geometry of pieces ---- */
-
-/* The point of live triangle k at lattice coordinates (i, j) of `level`: uv its parameters
- * along the edges v0->v1 and v0->v2, x its position. i / m is rounded once and scaled by a power
- * of two, so a point has the same bits at every level that holds it (shared corners agree). */
-static void lattice_point(const vpdsi_trimesh *mesh, uint64_t m, uint32_t k, double unit,
-                          uint64_t i, uint64_t j, double *uv, double *x)
-{
-    const uint32_t *t = mesh->tri + 3 * (size_t)mesh->live[k];
-    const double *a = mesh->v + 3 * (size_t)t[0], *b = mesh->v + 3 * (size_t)t[1];
-    const double *c = mesh->v + 3 * (size_t)t[2];
-    /* unit = 2^-level: the product is exact */
-    double u = (double)i / (double)m * unit, v = (double)j / (double)m * unit;
-    int q;
-    uv[0] = u;
-    uv[1] = v;
-    for (q = 0; q < 3; q++) x[q] = a[q] + u * (b[q] - a[q]) + v * (c[q] - a[q]);
-}
-
-static void piece_corners(const vpdsi_surface *s, const vpdsi_trimesh *mesh, const vpdsi_piece *p,
-                          double uv[3][2], double x[3][3])
-{
-    uint64_t m = s->seed_m[p->tri];
-    double unit = ldexp(1.0, -(int)p->level);
-    if (p->down) {
-        lattice_point(mesh, m, p->tri, unit, p->i + 1, p->j, uv[0], x[0]);
-        lattice_point(mesh, m, p->tri, unit, p->i, p->j + 1, uv[1], x[1]);
-        lattice_point(mesh, m, p->tri, unit, p->i + 1, p->j + 1, uv[2], x[2]);
-    } else {
-        lattice_point(mesh, m, p->tri, unit, p->i, p->j, uv[0], x[0]);
-        lattice_point(mesh, m, p->tri, unit, p->i + 1, p->j, uv[1], x[1]);
-        lattice_point(mesh, m, p->tri, unit, p->i, p->j + 1, uv[2], x[2]);
-    }
-}
-
-/* Child q (0..3) of a piece: the midpoint split of Section 6's cells carried to triangles. */
-static vpdsi_piece child_of(const vpdsi_piece *p, int q)
-{
-    static const uint8_t up_di[4] = {0, 1, 0, 0}, up_dj[4] = {0, 0, 1, 0}, up_down[4] = {0, 0, 0, 1};
-    static const uint8_t dn_di[4] = {1, 0, 1, 1}, dn_dj[4] = {0, 1, 1, 1}, dn_down[4] = {1, 1, 1, 0};
-    vpdsi_piece c = *p;
-    c.level = (uint8_t)(p->level + 1);
-    c.i = 2 * p->i + (p->down ? dn_di[q] : up_di[q]);
-    c.j = 2 * p->j + (p->down ? dn_dj[q] : up_dj[q]);
-    c.down = p->down ? dn_down[q] : up_down[q];
-    return c;
-}
-
-static double piece_area(const vpdsi_surface *s, const vpdsi_trimesh *mesh, const vpdsi_piece *p)
-{
-    double m = (double)s->seed_m[p->tri];
-    return ldexp(mesh->area[p->tri] / (m * m), -2 * (int)p->level);
-}
-
-static double piece_edge(const vpdsi_surface *s, const vpdsi_trimesh *mesh, const vpdsi_piece *p)
-{
-    return ldexp(mesh->longest[p->tri] / (double)s->seed_m[p->tri], -(int)p->level);
-}
-
-static unsigned lattice_bits(uint64_t m)
-{
-    unsigned b = 0;
-    while (m) b++, m >>= 1;
-    return b;
-}
-
-/* r at a point of live triangle k (parameters uv, position x). */
-static vpds_status radius_on(const vpdsi_surface_ctx *ctx, uint32_t k, const double *uv,
-                             const double *x, double *r)
-{
-    const vpdsi_trimesh *mesh = ctx->mesh;
-    if (mesh->vr) {
-        const uint32_t *t = mesh->tri + 3 * (size_t)mesh->live[k];
-        *r = (1 - uv[0] - uv[1]) * mesh->vr[t[0]] + uv[0] * mesh->vr[t[1]] + uv[1] * mesh->vr[t[2]];
-        return VPDS_OK;
-    }
-    return vpdsi_store_radius_at(ctx->st, x, r);
-}
-
-/* Bounds of r over a piece: exact at the corners for vertex radii (r is linear there), the
- * constant, or r at the centroid widened by L times the farthest corner. */
-static vpds_status piece_bounds(const vpdsi_surface_ctx *ctx, const vpdsi_piece *p,
-                                double uv[3][2], double x[3][3], double *r_lo, double *r_hi)
-{
-    const vpdsi_store *st = ctx->st;
-    double r, c[3], cuv[2], h2 = 0;
-    int q, k;
-    vpds_status e;
-    if (ctx->mesh->vr) {
-        *r_lo = INFINITY;
-        *r_hi = 0;
-        for (q = 0; q < 3; q++) {
-            if ((e = radius_on(ctx, p->tri, uv[q], x[q], &r)) != VPDS_OK) return e;
-            if (r < *r_lo) *r_lo = r;
-            if (r > *r_hi) *r_hi = r;
-        }
-        return VPDS_OK;
-    }
-    if (st->sizing.kind == VPDSI_SIZING_CONSTANT) {
-        *r_lo = *r_hi = st->sizing.radius;
-        return VPDS_OK;
-    }
-    for (k = 0; k < 3; k++) c[k] = (x[0][k] + x[1][k] + x[2][k]) / 3;
-    cuv[0] = (uv[0][0] + uv[1][0] + uv[2][0]) / 3;
-    cuv[1] = (uv[0][1] + uv[1][1] + uv[2][1]) / 3;
-    for (q = 0; q < 3; q++) {
-        double d2 = 0;
-        for (k = 0; k < 3; k++) d2 += (x[q][k] - c[k]) * (x[q][k] - c[k]);
-        if (d2 > h2) h2 = d2;
-    }
-    if ((e = radius_on(ctx, p->tri, cuv, c, &r)) != VPDS_OK) return e;
-    *r_lo = r - st->sizing.lipschitz * sqrt(h2) * (1 + 1e-12);
-    *r_hi = r + st->sizing.lipschitz * sqrt(h2) * (1 + 1e-12);
-    if (*r_lo < 0) *r_lo = 0;
-    return VPDS_OK;
-}
-
 /* Whether the piece may split: above the coordinates' precision and the area darts can find. */
 static int splittable(const vpdsi_surface_ctx *ctx, const vpdsi_surface *s, const vpdsi_piece *p,
                       double r_hi)
 {
     double reach = s->t * ctx->coverage * r_hi;
-    return p->level + lattice_bits(s->seed_m[p->tri]) < PIECE_MAX_LEVEL &&
-           piece_edge(s, ctx->mesh, p) >= 2 * ctx->mesh->min_edge &&
-           piece_area(s, ctx->mesh, p) >= MIN_AREA_FRACTION * reach * reach;
+    return p->level + vpdsi_lattice_bits(s->seed_m[p->tri]) < PIECE_MAX_LEVEL &&
+           vpdsi_piece_edge(ctx->mesh, s->seed_m[p->tri], p) >= 2 * ctx->mesh->min_edge &&
+           vpdsi_piece_area(ctx->mesh, s->seed_m[p->tri], p) >= MIN_AREA_FRACTION * reach * reach;
 }
 
 /* ---- coverage ---- */
@@ -297,7 +180,7 @@ static vpds_status seed_radius(const vpdsi_surface_ctx *ctx, uint32_t k, double 
     }
     for (q = 0; q < 3; q++)
         c[q] = (mesh->v[3 * (size_t)t[0] + q] + mesh->v[3 * (size_t)t[1] + q] + mesh->v[3 * (size_t)t[2] + q]) / 3;
-    return radius_on(ctx, k, uv, c, r);
+    return vpdsi_trimesh_radius(ctx->mesh, ctx->st, k, uv, c, r);
 }
 
 /* Index the samples: the octave grid when the largest radius is known, else the kd-tree. */
@@ -452,7 +335,8 @@ static vpds_status build_piece_sums(vpdsi_surface *s, const vpdsi_surface_ctx *c
         vpdsi_store_error(ctx->st, "out of memory for the areas of %zu pieces", s->n_cur);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
-    for (k = 0; k < s->n_cur; k++) s->cum[k] = sum += piece_area(s, ctx->mesh, &s->cur[k]);
+    for (k = 0; k < s->n_cur; k++)
+        s->cum[k] = sum += vpdsi_piece_area(ctx->mesh, s->seed_m[s->cur[k].tri], &s->cur[k]);
     s->cum_ready = 1;
     return VPDS_OK;
 }
@@ -479,7 +363,7 @@ static vpds_status piece_darts_step(vpdsi_surface *s, const vpdsi_surface_ctx *c
         double uv[2], x[3], r;
         int32_t witness = -1, hit;
         draw_piece_dart(s, ctx, &tri, uv, x);
-        if ((e = radius_on(ctx, tri, uv, x, &r)) != VPDS_OK) {
+        if ((e = vpdsi_trimesh_radius(ctx->mesh, ctx->st, tri, uv, x, &r)) != VPDS_OK) {
             *ctx->rng = before;
             return e;
         }
@@ -511,10 +395,11 @@ static vpds_status sweep_one_piece(vpdsi_surface *s, const vpdsi_surface_ctx *ct
     double uv[3][2], x[3][3], r_lo, r_hi;
     vpds_status e;
     int q;
-    piece_corners(s, ctx->mesh, p, uv, x);
-    if ((e = piece_bounds(ctx, p, uv, x, &r_lo, &r_hi)) != VPDS_OK) return e;
+    vpdsi_piece_corners(ctx->mesh, s->seed_m[p->tri], p, uv, x);
+    if ((e = vpdsi_piece_bounds(ctx->mesh, ctx->st, p, uv, x, &r_lo, &r_hi)) != VPDS_OK) return e;
     if (s->last_cover >= 0 && holds_corners(s, ctx, s->last_cover, x, r_lo)) return VPDS_OK;
-    if ((e = piece_near(s, ctx, x, r_hi, piece_edge(s, ctx->mesh, p))) != VPDS_OK) return e;
+    if ((e = piece_near(s, ctx, x, r_hi, vpdsi_piece_edge(ctx->mesh, s->seed_m[p->tri], p))) != VPDS_OK)
+        return e;
     if (corners_covered(s, ctx, x, r_lo)) return VPDS_OK;
     if (!split || !splittable(ctx, s, p, r_hi)) {
         s->next[s->n_next++] = *p;
@@ -522,12 +407,12 @@ static vpds_status sweep_one_piece(vpdsi_surface *s, const vpdsi_surface_ctx *ct
     }
     s->split_any = 1;
     for (q = 0; q < 4; q++) {
-        vpdsi_piece c = child_of(p, q);
+        vpdsi_piece c = vpdsi_piece_child(p, q);
         double cuv[3][2], cx[3][3], c_lo = r_lo, c_hi = r_hi;
-        piece_corners(s, ctx->mesh, &c, cuv, cx);
+        vpdsi_piece_corners(ctx->mesh, s->seed_m[c.tri], &c, cuv, cx);
         /* a child lies in its parent: the parent's bounds hold, vertex radii's exact ones are
          * tighter */
-        if (ctx->mesh->vr && (e = piece_bounds(ctx, &c, cuv, cx, &c_lo, &c_hi)) != VPDS_OK) return e;
+        if (ctx->mesh->vr && (e = vpdsi_piece_bounds(ctx->mesh, ctx->st, &c, cuv, cx, &c_lo, &c_hi)) != VPDS_OK) return e;
         if (!corners_covered(s, ctx, cx, c_lo)) s->next[s->n_next++] = c;
         if (c.level + 1u > ctx->stats->levels) ctx->stats->levels = c.level + 1u;
     }
@@ -579,8 +464,10 @@ static void finish_piece_sweep(vpdsi_surface *s, const vpdsi_surface_ctx *ctx)
         s->phase = VPDSI_SURF_DONE;
     } else if (!was_filter && !s->split_any) {
         double worst = 0;
-        for (k = 0; k < s->n_cur; k++)
-            if (piece_edge(s, ctx->mesh, &s->cur[k]) > worst) worst = piece_edge(s, ctx->mesh, &s->cur[k]);
+        for (k = 0; k < s->n_cur; k++) {
+            double edge = vpdsi_piece_edge(ctx->mesh, s->seed_m[s->cur[k].tri], &s->cur[k]);
+            if (edge > worst) worst = edge;
+        }
         ctx->stats->delta = worst;
         s->phase = VPDSI_SURF_DONE;
     } else {

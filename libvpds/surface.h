@@ -5,33 +5,8 @@
  * sample's triangle and barycentric coordinates beside it. */
 #ifndef VPDS_SURFACE_H
 #define VPDS_SURFACE_H
+#include "pieces.h"
 #include "rng.h"
-#include "store.h"
-
-/* The mesh as the algorithm reads it (owned by the entry point): only the triangles of positive
- * area, "live", take part. */
-typedef struct vpdsi_trimesh {
-    const double *v;          /* vertices, 3 doubles each */
-    const uint32_t *tri;      /* 3 vertex indices per triangle */
-    const double *vr;         /* per-vertex radii (NULL: the store's sizing) */
-    size_t n_vertices;
-    const uint32_t *live;     /* the triangles with area, ascending */
-    const double *area;       /* per live triangle */
-    const double *longest;    /* per live triangle: its longest edge */
-    size_t n_live;
-    double min_edge;          /* 2^-44 of the coordinates' magnitude: no piece splits below */
-} vpdsi_trimesh;
-
-/* A piece: lattice triangle (i, j) of live triangle `tri` cut into m x m seed pieces (m of the
- * triangle, chosen per scale so that a seed piece lies within one disk) and split `level` times
- * more, pointing up (corners (i,j), (i+1,j), (i,j+1) in units of 1 / (m 2^level) along its two
- * edges) or down (corners (i+1,j), (i,j+1), (i+1,j+1)). */
-typedef struct vpdsi_piece {
-    uint64_t i, j;
-    uint32_t tri;
-    uint8_t level, down;
-    uint16_t pad;
-} vpdsi_piece;
 
 typedef enum {
     VPDSI_SURF_IDLE, VPDSI_SURF_SEED, VPDSI_SURF_FILTER, VPDSI_SURF_DARTS, VPDSI_SURF_SWEEP,
