@@ -5,6 +5,7 @@
  *        | threads DIM RADIUS TILES THREADS (vpds_tiling_run of TILES per axis on THREADS threads)
  *        | mesh square|sphere RADIUS (the unit square as two triangles, or the unit sphere as an
  *          icosahedron split into 40^2 triangles per face: vpds_mesh_run)
+ *        | meshstream N (N calls of vpds_mesh_next on that sphere)
  *        | meshfile FILE RADIUS (vertices and triangles from a text file: "nv nt", then nv lines
  *          of x y z, then nt lines of i j k) */
 #include "rng.h"
@@ -169,6 +170,35 @@ static int run_mesh(const char *name, const double *v, size_t nv, const uint32_t
     return 0;
 }
 
+/* The stream on the unit sphere: n calls of vpds_mesh_next. */
+static int mesh_stream(size_t n)
+{
+    vpds_mesh_desc md = vpds_default_mesh_desc();
+    vpds_mesh *m;
+    double *v, x[3], t, t0;
+    uint32_t *tri;
+    size_t nv, nt, i;
+    icosphere(40, &v, &tri, &nv, &nt);
+    md.vertices = v;
+    md.n_vertices = nv;
+    md.triangles = tri;
+    md.n_triangles = nt;
+    md.radius = 1;
+    md.seed = 1;
+    if (vpds_mesh_create(&md, &m) != VPDS_OK) return 1;
+    t0 = now();
+    for (i = 0; i < n; i++)
+        if (vpds_mesh_next(m, 0, x, &t) != VPDS_OK) {
+            fprintf(stderr, "meshstream: %s\n", vpds_mesh_last_error(m));
+            return 1;
+        }
+    printf("meshstream %zu %.6f %zu\n", n, now() - t0, vpds_mesh_get_stats(m).peak_bytes);
+    vpds_mesh_destroy(m);
+    free(v);
+    free(tri);
+    return 0;
+}
+
 static int mesh_file(const char *path, double radius)
 {
     FILE *f = fopen(path, "r");
@@ -243,6 +273,7 @@ int main(int argc, char **argv)
         free(t);
         return rc;
     }
+    if (argc >= 3 && !strcmp(argv[1], "meshstream")) return mesh_stream((size_t)atof(argv[2]));
     if (argc >= 4 && !strcmp(argv[1], "meshfile")) return mesh_file(argv[2], atof(argv[3]));
     if (argc >= 4 && !strcmp(argv[1], "floor")) {
         /* the floor: as many uniform random points with the library's own generator */
@@ -259,6 +290,6 @@ int main(int argc, char **argv)
         return 0;
     }
     fprintf(stderr, "usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION | ramp RULE"
-                    " | floor N DIM | stream DIM RADIUS N STEPS | mesh square|sphere RADIUS | meshfile FILE RADIUS\n");
+                    " | floor N DIM | stream DIM RADIUS N STEPS | mesh square|sphere RADIUS | meshstream N | meshfile FILE RADIUS\n");
     return 2;
 }

@@ -1,6 +1,6 @@
 /* Mesh descriptors and runs from the input: up to 10 vertices (NaN, inf and huge values now and
  * then), up to 8 triangles with any indices (out of range, repeated: degenerate), a radius or
- * vertex radii, a rule, a budget. A refused descriptor has a documented status and a message,
+ * vertex radii, a rule, a budget; a run or the stream. A refused descriptor has a documented status and a message,
  * and create refuses it too; an accepted one runs (through pauses) to a documented status, its
  * samples on their triangles and conflict-free, and a completed run covers probes on every
  * triangle of area. */
@@ -29,10 +29,11 @@ static double radius_at(const double *vr, double radius, const uint32_t *t, cons
 }
 
 static void check_run(const vpds_mesh *s, const double *v, const uint32_t *tri, size_t nt,
-                      const double *vr, double radius, vpds_rule rule, int complete)
+                      const double *vr, double radius, vpds_rule rule, int complete, double tol)
 {
     size_t n = vpds_mesh_count(s), i, j, f;
     const double *x = vpds_mesh_points(s), *r = vpds_mesh_radii(s), *bc = vpds_mesh_barycentrics(s);
+    const double *ts = vpds_mesh_scales(s);
     const uint32_t *face = vpds_mesh_faces(s);
     if (rule == VPDS_RULE_DEFAULT) rule = VPDS_RULE_SMALLER;
     for (i = 0; i < n; i++) {
@@ -47,7 +48,7 @@ static void check_run(const vpds_mesh *s, const double *v, const uint32_t *tri, 
         }
         FUZZ_ASSERT(fabs(r[i] - radius_at(vr, radius, t, bc + 3 * i)) <= 1e-12 * r[i], "radius of %zu", i);
         for (j = 0; j < i; j++) {
-            double d2 = 0, fr = rule_f(rule, r[j], r[i]);
+            double d2 = 0, fr = ts[i] * rule_f(rule, r[j], r[i]) * (1 - tol);
             for (k = 0; k < 3; k++) d2 += (x[3 * i + k] - x[3 * j + k]) * (x[3 * i + k] - x[3 * j + k]);
             FUZZ_ASSERT(d2 >= fr * fr * (1 - 1e-12), "samples %zu and %zu conflict", j, i);
         }
@@ -81,7 +82,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     double v[3 * MAX_V], vr[MAX_V];
     uint32_t tri[3 * MAX_T];
     size_t nv = 3 + take_u8(&in) % (MAX_V - 2), nt = take_u8(&in) % (MAX_T + 1), i;
-    int use_vr = take_u8(&in) & 1, calls;
+    int mode = take_u8(&in), use_vr = mode & 1, calls;
     char msg[512];
     vpds_mesh *s = NULL;
     vpds_status st;
@@ -105,12 +106,26 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         return 0;
     }
     FUZZ_ASSERT(vpds_mesh_create(&d, &s) == VPDS_OK, "create refused a valid descriptor");
+    if (mode & 2) {
+        /* the stream: t never rises, each sample on its triangle and clear of the others */
+        double x[3], t, last = INFINITY;
+        for (calls = 0; calls < 40 && (st = vpds_mesh_next(s, 0, x, &t)) == VPDS_OK; calls++) {
+            FUZZ_ASSERT(t <= last && !isnan(t), "stream t %g after %g", t, last);
+            last = t;
+        }
+        check_status(st);
+        FUZZ_ASSERT(st == VPDS_OK, "stream status %d: %s", (int)st, vpds_mesh_last_error(s));
+        FUZZ_ASSERT(vpds_mesh_run(s) == VPDS_ERR_STATE, "a run after the stream");
+        check_run(s, v, tri, nt, d.vertex_radii, d.radius, d.rule, 0, VPDS_STREAM_TOLERANCE);
+        vpds_mesh_destroy(s);
+        return 0;
+    }
     for (calls = 0; calls < 2000 && (st = vpds_mesh_run(s)) == VPDS_PAUSED; calls++) {}
     check_status(st);
     FUZZ_ASSERT(st == VPDS_OK || st == VPDS_PAUSED || st == VPDS_ERR_OVERFLOW, "status %d: %s", (int)st,
                 vpds_mesh_last_error(s));
     check_run(s, v, tri, nt, d.vertex_radii, d.radius, d.rule,
-              st == VPDS_OK && vpds_mesh_get_stats(s).delta == 0);
+              st == VPDS_OK && vpds_mesh_get_stats(s).delta == 0, 0);
     if (st == VPDS_OK) FUZZ_ASSERT(vpds_mesh_get_stats(s).maximal, "completed but not maximal");
     vpds_mesh_destroy(s);
     return 0;

@@ -510,6 +510,14 @@ VPDS_API vpds_status vpds_mesh_run(vpds_mesh *mesh);
 /* Continue a completed run down to the smaller scale t (0 < t < the current one): the samples
  * kept, new ones added until maximal at t (Section 4.1). */
 VPDS_API vpds_status vpds_mesh_refine(vpds_mesh *mesh, double t);
+/* The continuous stream on the surface (exactly n points: call it n times): the point farthest
+ * from the samples in the rule's scaled distance, found by branch and bound, with its scale t
+ * (+INFINITY for the first sample, uniform by area). Each prefix {x_k : t_k >= t} covers the
+ * surface at t * coverage and keeps conflict-free at t * inhibition * (1 - VPDS_STREAM_TOLERANCE).
+ * VPDS_STREAM_END: the next sample's t would be at or below t_min (nothing consumed). This
+ * version streams from an empty mesh sampler only, and a streaming one refuses runs
+ * (VPDS_ERR_STATE). x_out: 3 doubles; face and barycentrics through vpds_mesh_faces/_barycentrics. */
+VPDS_API vpds_status vpds_mesh_next(vpds_mesh *mesh, double t_min, double *x_out, double *t_out);
 VPDS_API vpds_status vpds_mesh_set_budget(vpds_mesh *mesh, uint64_t budget);
 VPDS_API size_t vpds_mesh_count(const vpds_mesh *mesh);
 /* count * 3 coordinates; r; the scale t each sample was placed at. */

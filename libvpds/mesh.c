@@ -6,6 +6,7 @@
 #include "refuse.h"
 #include "rules.h"
 #include "surface.h"
+#include "surface_stream.h"
 #include <math.h>
 #include <string.h>
 
@@ -25,6 +26,8 @@ struct vpds_mesh {
     vpdsi_trimesh view;
     vpdsi_store store;
     vpdsi_surface surface;
+    vpdsi_surface_marks marks;
+    vpdsi_surface_stream stream;   /* in use once vpds_mesh_next was called */
     vpdsi_rng rng;
     vpds_stats stats;
     vpds_rule rule;
@@ -304,6 +307,8 @@ void vpds_mesh_destroy(vpds_mesh *s)
     vpdsi_mem m;
     if (!live(s)) return;
     vpdsi_surface_release(&s->surface, &s->mem);
+    vpdsi_marks_release(&s->marks, &s->mem);
+    vpdsi_surface_stream_release(&s->stream, &s->mem);
     vpdsi_store_release(&s->store);
     free_arrays(s);
     m = s->mem;
@@ -323,6 +328,7 @@ static vpds_status mesh_work(vpds_mesh *s)
     vpdsi_surface_ctx c;
     c.mesh = &s->view;
     c.st = &s->store;
+    c.marks = &s->marks;
     c.rng = &s->rng;
     c.stats = &s->stats;
     c.rule = s->rule;
@@ -334,16 +340,29 @@ static vpds_status mesh_work(vpds_mesh *s)
     return vpdsi_surface_run(&s->surface, &c);
 }
 
+/* Runs and the stream do not mix in this version: say so, change nothing. */
+static vpds_status refuse_after_stream(vpds_mesh *s, const char *call)
+{
+    if (!s->stream.started) return VPDS_OK;
+    vpdsi_store_error(&s->store, "%s after vpds_mesh_next: a mesh sampler either runs (vpds_mesh_run, "
+                      "vpds_mesh_refine) or streams, not both", call);
+    return VPDS_ERR_STATE;
+}
+
 vpds_status vpds_mesh_run(vpds_mesh *s)
 {
+    vpds_status e;
     if (!live(s)) return VPDS_ERR_INVALID_ARGUMENT;
+    if ((e = refuse_after_stream(s, "vpds_mesh_run")) != VPDS_OK) return e;
     if (s->surface.phase == VPDSI_SURF_IDLE) vpdsi_surface_begin(&s->surface, 1.0);
     return mesh_work(s);
 }
 
 vpds_status vpds_mesh_refine(vpds_mesh *s, double t)
 {
+    vpds_status e;
     if (!live(s)) return VPDS_ERR_INVALID_ARGUMENT;
+    if ((e = refuse_after_stream(s, "vpds_mesh_refine")) != VPDS_OK) return e;
     if (s->surface.phase != VPDSI_SURF_IDLE && t == s->surface.t) return mesh_work(s);
     if (!isfinite(t) || !vpdsi_scale_ok(t * s->coverage)) {
         vpdsi_store_error(&s->store, "t = %g: must be finite, > 0, with t * coverage within [1e-50, 1e50]", t);
@@ -362,6 +381,34 @@ vpds_status vpds_mesh_refine(vpds_mesh *s, double t)
     return mesh_work(s);
 }
 
+vpds_status vpds_mesh_next(vpds_mesh *s, double t_min, double *x_out, double *t_out)
+{
+    vpdsi_surface_stream_ctx c;
+    if (!live(s)) return VPDS_ERR_INVALID_ARGUMENT;
+    if (!x_out || !t_out) {
+        vpdsi_store_error(&s->store, "vpds_mesh_next: x_out and t_out must not be NULL");
+        return VPDS_ERR_INVALID_ARGUMENT;
+    }
+    if (!(t_min >= 0) || t_min == INFINITY) {
+        vpdsi_store_error(&s->store, "vpds_mesh_next: t_min = %g: must be finite and >= 0", t_min);
+        return VPDS_ERR_INVALID_ARGUMENT;
+    }
+    if (s->surface.phase != VPDSI_SURF_IDLE) {
+        vpdsi_store_error(&s->store, "vpds_mesh_next after vpds_mesh_run or vpds_mesh_refine: the stream "
+                          "starts from an empty mesh sampler in this version");
+        return VPDS_ERR_STATE;
+    }
+    c.mesh = &s->view;
+    c.st = &s->store;
+    c.marks = &s->marks;
+    c.rng = &s->rng;
+    c.stats = &s->stats;
+    c.rule = s->rule;
+    c.coverage = s->coverage;
+    s->store.err[0] = 0;
+    return vpdsi_surface_next(&s->stream, &c, t_min, x_out, t_out);
+}
+
 vpds_status vpds_mesh_set_budget(vpds_mesh *s, uint64_t budget)
 {
     if (!live(s)) return VPDS_ERR_INVALID_ARGUMENT;
@@ -373,8 +420,8 @@ size_t vpds_mesh_count(const vpds_mesh *s) { return live(s) ? s->store.n : 0; }
 const double *vpds_mesh_points(const vpds_mesh *s) { return live(s) ? s->store.x : NULL; }
 const double *vpds_mesh_radii(const vpds_mesh *s) { return live(s) ? s->store.r : NULL; }
 const double *vpds_mesh_scales(const vpds_mesh *s) { return live(s) ? s->store.t : NULL; }
-const uint32_t *vpds_mesh_faces(const vpds_mesh *s) { return live(s) ? s->surface.face : NULL; }
-const double *vpds_mesh_barycentrics(const vpds_mesh *s) { return live(s) ? s->surface.bary : NULL; }
+const uint32_t *vpds_mesh_faces(const vpds_mesh *s) { return live(s) ? s->marks.face : NULL; }
+const double *vpds_mesh_barycentrics(const vpds_mesh *s) { return live(s) ? s->marks.bary : NULL; }
 
 vpds_stats vpds_mesh_get_stats(const vpds_mesh *s)
 {
@@ -387,7 +434,7 @@ vpds_stats vpds_mesh_get_stats(const vpds_mesh *s)
     st.bytes_held = s->mem.held;
     st.peak_bytes = s->mem.peak;
     st.sizing_calls = s->store.sizing.calls;
-    st.t = s->surface.t;
+    st.t = s->stream.started ? (s->store.n ? s->store.t[s->store.n - 1] : INFINITY) : s->surface.t;
     st.maximal = s->surface.phase == VPDSI_SURF_DONE;
     return st;
 }

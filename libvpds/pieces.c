@@ -119,3 +119,35 @@ void vpdsi_trimesh_point(const vpdsi_trimesh *mesh, uint32_t k, const double *uv
     int q;
     for (q = 0; q < 3; q++) x[q] = a[q] + uv[0] * (b[q] - a[q]) + uv[1] * (c[q] - a[q]);
 }
+
+void vpdsi_marks_release(vpdsi_surface_marks *mk, vpdsi_mem *m)
+{
+    vpdsi_mem_free(m, mk->face, mk->cap_face * sizeof *mk->face);
+    vpdsi_mem_free(m, mk->bary, mk->cap_bary * sizeof *mk->bary);
+    mk->face = NULL;
+    mk->bary = NULL;
+    mk->cap_face = mk->cap_bary = 0;
+}
+
+vpds_status vpdsi_marks_reserve(vpdsi_surface_marks *mk, vpdsi_store *st, size_t more)
+{
+    vpds_status e = vpdsi_store_reserve(st, more);
+    size_t need = st->n + more;
+    if (e != VPDS_OK) return e;
+    if (vpdsi_mem_reserve(st->mem, (void **)&mk->face, &mk->cap_face, need, sizeof *mk->face) ||
+        vpdsi_mem_reserve(st->mem, (void **)&mk->bary, &mk->cap_bary, 3 * need, sizeof *mk->bary)) {
+        vpdsi_store_error(st, "out of memory for %zu samples", need);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    return VPDS_OK;
+}
+
+void vpdsi_marks_append(vpdsi_surface_marks *mk, vpdsi_store *st, const vpdsi_trimesh *mesh,
+                        uint32_t k, const double *uv, const double *x, double r, double t)
+{
+    mk->face[st->n] = mesh->live[k];
+    mk->bary[3 * st->n] = 1 - uv[0] - uv[1];
+    mk->bary[3 * st->n + 1] = uv[0];
+    mk->bary[3 * st->n + 2] = uv[1];
+    vpdsi_store_append(st, x, r, t, 0);
+}

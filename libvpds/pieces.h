@@ -31,6 +31,21 @@ typedef struct vpdsi_piece {
     uint16_t pad;
 } vpdsi_piece;
 
+/* What a surface sample carries besides the store's point, r and t: its triangle and
+ * barycentric coordinates, one entry per sample of the store. */
+typedef struct vpdsi_surface_marks {
+    uint32_t *face; size_t cap_face;     /* the triangle (index into tri) */
+    double *bary; size_t cap_bary;       /* 3 barycentric coordinates */
+} vpdsi_surface_marks;
+
+void vpdsi_marks_release(vpdsi_surface_marks *mk, vpdsi_mem *m);
+/* Room for `more` samples in the store and the marks; nothing changes on failure. */
+vpds_status vpdsi_marks_reserve(vpdsi_surface_marks *mk, vpdsi_store *st, size_t more);
+/* Append the point x of live triangle k at parameters uv with radius r and scale t (after a
+ * reserve). */
+void vpdsi_marks_append(vpdsi_surface_marks *mk, vpdsi_store *st, const vpdsi_trimesh *mesh,
+                        uint32_t k, const double *uv, const double *x, double r, double t);
+
 /* Corners of a piece (of a triangle cut into m x m seeds): parameters uv and positions x. */
 void vpdsi_piece_corners(const vpdsi_trimesh *mesh, uint64_t m, const vpdsi_piece *p,
                          double uv[3][2], double x[3][3]);

@@ -43,11 +43,6 @@ static void release_pieces(vpdsi_surface *s, vpdsi_mem *m)
 void vpdsi_surface_release(vpdsi_surface *s, vpdsi_mem *m)
 {
     release_pieces(s, m);
-    vpdsi_mem_free(m, s->face, s->cap_face * sizeof *s->face);
-    vpdsi_mem_free(m, s->bary, s->cap_bary * sizeof *s->bary);
-    s->face = NULL;
-    s->bary = NULL;
-    s->cap_face = s->cap_bary = 0;
 }
 
 void vpdsi_surface_begin(vpdsi_surface *s, double t)
@@ -314,19 +309,6 @@ static void draw_piece_dart(const vpdsi_surface *s, const vpdsi_surface_ctx *ctx
     for (q = 0; q < 3; q++) x[q] = va[q] + uv[0] * (vb[q] - va[q]) + uv[1] * (vc[q] - va[q]);
 }
 
-static vpds_status reserve_surface_samples(vpdsi_surface *s, vpdsi_store *st, size_t more)
-{
-    vpds_status e = vpdsi_store_reserve(st, more);
-    size_t need = st->n + more;
-    if (e != VPDS_OK) return e;
-    if (vpdsi_mem_reserve(st->mem, (void **)&s->face, &s->cap_face, need, sizeof *s->face) ||
-        vpdsi_mem_reserve(st->mem, (void **)&s->bary, &s->cap_bary, 3 * need, sizeof *s->bary)) {
-        vpdsi_store_error(st, "out of memory for %zu samples", need);
-        return VPDS_ERR_OUT_OF_MEMORY;
-    }
-    return VPDS_OK;
-}
-
 static vpds_status build_piece_sums(vpdsi_surface *s, const vpdsi_surface_ctx *ctx)
 {
     double sum = 0;
@@ -356,7 +338,7 @@ static vpds_status piece_darts_step(vpdsi_surface *s, const vpdsi_surface_ctx *c
     }
     if (!s->implicit && !s->cum_ready && (e = build_piece_sums(s, ctx)) != VPDS_OK) return e;
     if (s->darts_left < limit) limit = s->darts_left;
-    if ((e = reserve_surface_samples(s, st, (size_t)limit)) != VPDS_OK) return e;
+    if ((e = vpdsi_marks_reserve(ctx->marks, st, (size_t)limit)) != VPDS_OK) return e;
     while (*done < limit) {
         vpdsi_rng before = *ctx->rng;
         uint32_t tri;
@@ -377,11 +359,7 @@ static vpds_status piece_darts_step(vpdsi_surface *s, const vpdsi_surface_ctx *c
         s->darts_left--;
         ctx->stats->darts++;
         if (hit != -1) continue;
-        s->face[st->n] = ctx->mesh->live[tri];
-        s->bary[3 * st->n] = 1 - uv[0] - uv[1];
-        s->bary[3 * st->n + 1] = uv[0];
-        s->bary[3 * st->n + 2] = uv[1];
-        vpdsi_store_append(st, x, r, s->t, 0);
+        vpdsi_marks_append(ctx->marks, st, ctx->mesh, tri, uv, x, r, s->t);
         ctx->stats->accepted++;
     }
     return VPDS_OK;

@@ -1,8 +1,8 @@
 /* Algorithm 1 on a triangle mesh: active pieces are sub-triangles of the lattice that midpoint
  * subdivision makes (each split gives four similar children of equal area), darts land uniform
  * by area over the active pieces, and a piece is dropped once one sample covers its three
- * corners (a ball is convex). Samples go to the store (3D, kd-tree); the surface keeps each
- * sample's triangle and barycentric coordinates beside it. */
+ * corners (a ball is convex). Samples go to the store (3D) with their triangle and barycentric
+ * coordinates in the marks beside it. */
 #ifndef VPDS_SURFACE_H
 #define VPDS_SURFACE_H
 #include "pieces.h"
@@ -36,14 +36,13 @@ typedef struct vpdsi_surface {
     uint64_t darts_left;
     int split_any;                       /* the sweep split a piece (else the run ends) */
     int32_t *near; size_t n_near, cap_near;
-    uint32_t *face; size_t cap_face;     /* per sample: its triangle (index into tri) */
-    double *bary; size_t cap_bary;       /* per sample: 3 barycentric coordinates */
 } vpdsi_surface;
 
 /* What one call may do, and the problem's constants. */
 typedef struct vpdsi_surface_ctx {
     const vpdsi_trimesh *mesh;
     vpdsi_store *st;
+    vpdsi_surface_marks *marks;
     vpdsi_rng *rng;
     vpds_stats *stats;
     vpds_rule rule;           /* resolved */

@@ -820,6 +820,146 @@ static void test_bias(void)
     mesh_free(&sq);
 }
 
+/* Probes of the barycentric lattice (edges and corners included) of every triangle of area that
+ * no sample of x[0..n) covers at scale t; brute force. */
+static size_t uncovered_probes(const mesh_t *m, const double *vr, radius_fn rf, vpds_rule rule, double t,
+                               const double *x, const double *r, size_t n, int steps)
+{
+    size_t f, bad = 0, i;
+    for (f = 0; f < m->nt; f++) {
+        double longest, area = tri_area(m, f, &longest);
+        const uint32_t *tv = m->t + 3 * f;
+        int a, b, k;
+        if (!(area > 9.094947017729282e-13 * longest * longest)) continue;
+        for (a = 0; a <= steps; a++)
+            for (b = 0; a + b <= steps; b++) {
+                double bb[3] = {1 - (double)(a + b) / steps, (double)a / steps, (double)b / steps}, y[3], ry;
+                int hit = 0;
+                for (k = 0; k < 3; k++)
+                    y[k] = bb[0] * m->v[3 * tv[0] + k] + bb[1] * m->v[3 * tv[1] + k] + bb[2] * m->v[3 * tv[2] + k];
+                ry = rf(m, vr, (uint32_t)f, bb, y);
+                for (i = 0; i < n && !hit; i++) {
+                    double d2 = 0, fr = t * rule_f(rule, r[i], ry);
+                    for (k = 0; k < 3; k++) d2 += (y[k] - x[3 * i + k]) * (y[k] - x[3 * i + k]);
+                    hit = d2 <= fr * fr * (1 + 1e-9);
+                }
+                bad += !hit;
+            }
+    }
+    return bad;
+}
+
+/* The stream on a surface: n samples, t non-increasing, each prefix covered at its t and
+ * conflict-free within the stream's tolerance, by brute force; determinism, STREAM_END consuming
+ * nothing, runs and streams refusing to mix, every allocation failing once. */
+static void stream_case(const char *what, const mesh_t *m, const double *vr, radius_fn rf, vpds_rule rule,
+                        double radius, size_t n)
+{
+    vpds_mesh_desc d = desc_for(m);
+    vpds_mesh *s = NULL;
+    double x[3], t, last = INFINITY;
+    size_t k, i, j, conflicts = 0, bad_t = 0, checked = 0, uncovered = 0;
+    vpds_status st = VPDS_OK;
+    d.radius = r_const_val = radius;
+    d.vertex_radii = vr;
+    d.rule = rule;
+    d.seed = 77;
+    if (vpds_mesh_create(&d, &s) != VPDS_OK) { CHECK(0); return; }
+    for (k = 0; k < n && (st = vpds_mesh_next(s, 0, x, &t)) == VPDS_OK; k++) {
+        const double *xs = vpds_mesh_points(s), *rs = vpds_mesh_radii(s);
+        CHECK(memcmp(x, xs + 3 * k, sizeof x) == 0);
+        bad_t += k == 0 ? !(t == INFINITY) : !(t <= last);
+        last = t;
+        if (k > 0 && (k % (n / 6) == 0 || k == n - 1)) {
+            /* the samples before k cover the surface at t_k (t_k is where they stop being maximal) */
+            uncovered += uncovered_probes(m, vr, rf, rule, t, xs, rs, k, quick ? 6 : 10);
+            checked++;
+        }
+    }
+    CHECK_MSG(st == VPDS_OK && vpds_mesh_count(s) == n, "%s: status %d after %zu: %s", what, (int)st, k,
+              vpds_mesh_last_error(s));
+    for (j = 1; j < vpds_mesh_count(s); j++)
+        for (i = 0; i < j; i++) {
+            const double *xs = vpds_mesh_points(s), *rs = vpds_mesh_radii(s), *ts = vpds_mesh_scales(s);
+            double d2 = 0, fr = ts[j] * rule_f(rule, rs[i], rs[j]) * (1 - VPDS_STREAM_TOLERANCE);
+            int q;
+            for (q = 0; q < 3; q++) d2 += (xs[3 * i + q] - xs[3 * j + q]) * (xs[3 * i + q] - xs[3 * j + q]);
+            conflicts += d2 < fr * fr;
+        }
+    CHECK_MSG(bad_t == 0, "%s: %zu scales out of order", what, bad_t);
+    CHECK_MSG(conflicts == 0, "%s: %zu pairs in conflict", what, conflicts);
+    CHECK_MSG(checked > 3 && uncovered == 0, "%s: %zu probes uncovered over %zu prefixes", what, uncovered, checked);
+    {
+        /* faces and barycentrics name each sample's place */
+        report_t rep = check_mesh_run(s, m, vr, rf, rule, 1e300, 1, 1);
+        CHECK_MSG(rep.off_surface == 0 && rep.bad_radius == 0, "%s: %zu off, %zu radii", what,
+                  rep.off_surface, rep.bad_radius);
+    }
+    vpds_mesh_destroy(s);
+}
+
+static void test_stream(void)
+{
+    mesh_t sphere = icosphere(3), sq = {0};
+    double *vr = (double *)malloc(sphere.nv * sizeof(double));
+    size_t i, n = quick ? 60 : 300;
+    int rule;
+    vpds_mesh_desc d;
+    vpds_mesh *a, *b;
+    double x[3], t, xa[3], ta;
+    counting_t ca = {0, 0, 0};
+    square_part(&sq, 0, 1, 5, 5, 0, 0.5, 4);
+    stream_case("stream, sphere", &sphere, NULL, r_const, VPDS_RULE_SMALLER, 0.3, n);
+    stream_case("stream, square", &sq, NULL, r_const, VPDS_RULE_SMALLER, 0.2, n);
+    for (i = 0; i < sphere.nv; i++) vr[i] = 0.3 + 0.1 * sphere.v[3 * i + 2];
+    for (rule = 1; rule <= 4; rule++) stream_case("stream, vertex radii", &sphere, vr, r_vertex, (vpds_rule)rule, 0, n / 2);
+    /* same seed, same stream; STREAM_END takes nothing; runs and streams do not mix */
+    d = desc_for(&sphere);
+    d.radius = 0.3;
+    d.seed = 5;
+    CHECK(vpds_mesh_create(&d, &a) == VPDS_OK && vpds_mesh_create(&d, &b) == VPDS_OK);
+    for (i = 0; i < 40; i++) CHECK(vpds_mesh_next(a, 0, x, &t) == VPDS_OK);
+    CHECK(vpds_mesh_next(a, 1e9, x, &t) == VPDS_STREAM_END && vpds_mesh_count(a) == 40);
+    CHECK(vpds_mesh_next(a, t, xa, &ta) == VPDS_STREAM_END); /* t: the 40th's, above the 41st's */
+    CHECK(vpds_mesh_next(a, 0, xa, &ta) == VPDS_OK && ta <= t);
+    for (i = 0; i < 41; i++) CHECK(vpds_mesh_next(b, 0, x, &t) == VPDS_OK);
+    CHECK(memcmp(x, xa, sizeof x) == 0 && t == ta && same_samples(a, b));
+    CHECK(vpds_mesh_run(a) == VPDS_ERR_STATE && strstr(vpds_mesh_last_error(a), "not both"));
+    CHECK(vpds_mesh_refine(a, 0.5) == VPDS_ERR_STATE && vpds_mesh_count(a) == 41);
+    CHECK(vpds_mesh_next(a, -1, x, &t) == VPDS_ERR_INVALID_ARGUMENT);
+    CHECK(vpds_mesh_next(a, 0, NULL, &t) == VPDS_ERR_INVALID_ARGUMENT);
+    vpds_mesh_destroy(a);
+    CHECK(vpds_mesh_create(&d, &a) == VPDS_OK && vpds_mesh_run(a) == VPDS_OK);
+    CHECK(vpds_mesh_next(a, 0, x, &t) == VPDS_ERR_STATE && strstr(vpds_mesh_last_error(a), "empty mesh sampler"));
+    vpds_mesh_destroy(a);
+    /* every allocation failing once: the retried stream gives the same points */
+    d.allocator.alloc = ca_alloc;
+    d.allocator.free = ca_free;
+    d.allocator.user = &ca;
+    CHECK(vpds_mesh_create(&d, &a) == VPDS_OK);
+    for (i = 0; i < 41; i++) CHECK(vpds_mesh_next(a, 0, x, &t) == VPDS_OK);
+    vpds_mesh_destroy(a);
+    {
+        size_t sites = ca.calls, k;
+        for (k = 1; k <= sites; k += quick ? 5 : 1) {
+            vpds_status st;
+            ca.calls = 0;
+            ca.fail_at = k;
+            while ((st = vpds_mesh_create(&d, &a)) == VPDS_ERR_OUT_OF_MEMORY) {}
+            for (i = 0; i < 41; i++)
+                while ((st = vpds_mesh_next(a, 0, x, &t)) == VPDS_ERR_OUT_OF_MEMORY) {}
+            CHECK_MSG(st == VPDS_OK && same_samples(a, b), "stream, allocation %zu failing", k);
+            vpds_mesh_destroy(a);
+            CHECK(ca.live_bytes == 0);
+        }
+        ca.fail_at = 0;
+    }
+    vpds_mesh_destroy(b);
+    free(vr);
+    mesh_free(&sphere);
+    mesh_free(&sq);
+}
+
 int main(void)
 {
     quick = getenv("VPDS_TEST_QUICK") != NULL;
@@ -830,5 +970,6 @@ int main(void)
     test_degenerate();
     test_determinism();
     test_bias();
+    test_stream();
     CHECK_DONE();
 }

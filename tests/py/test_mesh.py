@@ -125,6 +125,28 @@ def test_sizing_callable_and_refinement():
         m.refine(0.7)
 
 
+def test_exactly_n_points_from_the_stream():
+    m = trimesh.creation.icosphere(subdivisions=2)
+    v, f = np.asarray(m.vertices), np.asarray(m.faces)
+    s = vpds.sample_mesh(m, radius=0.2, n=150, rng=3)
+    assert len(s.points) == 150 and s.scales[0] == np.inf and np.all(np.diff(s.scales) <= 0)
+    np.testing.assert_allclose(np.einsum("nk,nkd->nd", s.barycentrics, v[f[s.faces]]), s.points, atol=1e-12)
+    # each prefix: the samples before k cover the surface at t_k, and none is closer than t_k r
+    y, _, _ = probes(v, f, 2000.0, np.random.default_rng(2))
+    for k in (10, 60, 149):
+        d, _ = cKDTree(s.points[:k]).query(y)
+        assert d.max() <= s.scales[k] * 0.2 * (1 + 1e-9)
+        dd, _ = cKDTree(s.points[:k + 1]).query(s.points[:k + 1], k=2)
+        assert dd[:, 1].min() >= s.scales[k] * 0.2 * (1 - vpds.STREAM_TOLERANCE)
+    again = vpds.MeshSampler(m, radius=0.2, rng=3)
+    again.progressive(60)
+    np.testing.assert_array_equal(again.progressive(150).points, s.points)
+    with pytest.raises(vpds.VpdsStateError, match="not both"):
+        again.run()
+    with pytest.raises(ValueError, match="give one"):
+        vpds.sample_mesh(m, n=10, t=0.5)
+
+
 def test_bad_input_is_named():
     v, f = square(2)
     with pytest.raises(vpds.VpdsValueError, match="triangle 1 corner 2 is vertex 99"):

@@ -137,6 +137,19 @@ class MeshSampler:
         self._drive(lambda: lib.vpds_mesh_refine(self._m, t))
         return self
 
+    def progressive(self, n: int) -> MeshSamples:
+        """Continue the stream to n samples in all (the first ones stay): each prefix is
+        conflict-free and maximal at its own scale, so the n points are evenly spread at the
+        last one's t (the farthest point of the surface in the rule's scaled distance, each in
+        turn; the first uniform by area). A sampler that ran does not stream."""
+        if not isinstance(n, (int, np.integer)) or isinstance(n, bool) or n < 0:
+            raise ValueError(f"n = {n!r}: must be an int >= 0")
+        x = ffi.new("double[3]")
+        t = ffi.new("double *")
+        while int(lib.vpds_mesh_count(self._m)) < n:
+            self._check(lib.vpds_mesh_next(self._m, 0.0, x, t))
+        return self.samples
+
     @property
     def samples(self) -> MeshSamples:
         n = int(lib.vpds_mesh_count(self._m))
@@ -159,7 +172,8 @@ class MeshSampler:
 def sample_mesh(vertices: Any, faces: Any = None, *, radius: float = 0.05,
                 sizing: Optional[SizingFunction] = None, vertex_radii: Optional[npt.ArrayLike] = None,
                 lipschitz: Optional[float] = None, rule: str = "smaller", inhibition: float = 1.0,
-                coverage: float = 1.0, rng: RngLike = None, t: Union[float, int] = 1.0) -> MeshSamples:
+                coverage: float = 1.0, rng: RngLike = None, t: Union[float, int] = 1.0,
+                n: Optional[int] = None) -> MeshSamples:
     """A maximal Poisson-disk sampling of a triangle mesh.
 
     vertices, faces: (n, 3) coordinates and (m, 3) vertex indices, or a trimesh.Trimesh (or any
@@ -167,10 +181,16 @@ def sample_mesh(vertices: Any, faces: Any = None, *, radius: float = 0.05,
     `vertex_radii` (one per vertex, linear over each triangle) or `sizing` (a vectorised r(x)
     of (k, 3) points, with its `lipschitz`). rule, inhibition, coverage as for PoissonDisk (this
     version needs inhibition == coverage). rng: an int seed (the C seed) or a numpy Generator.
-    t: the scale (1: the radius itself).
+    t: the scale (1: the radius itself). n: exactly n points instead, evenly spread: the first n
+    samples of the stream on the surface (`scales` then says the scale each prefix reaches; the
+    radius sets only the shape of the spacing, r relative to itself).
     """
     m = MeshSampler(vertices, faces, radius=radius, sizing=sizing, vertex_radii=vertex_radii,
                     lipschitz=lipschitz, rule=rule, inhibition=inhibition, coverage=coverage, rng=rng)
+    if n is not None:
+        if float(t) != 1.0:
+            raise ValueError(f"n = {n} with t = {t}: give one (n points from the stream, or a run at t)")
+        return m.progressive(n)
     if float(t) == 1.0:
         m.run()
     else:

@@ -1,0 +1,192 @@
+/* The continuous stream on a surface (surface_stream.h): farthest-point insertion by branch and
+ * bound over pieces of the triangles (each triangle one piece at level 0, m = 1). */
+#include "surface_stream.h"
+#include "rules.h"
+#include <math.h>
+#include <string.h>
+
+#define STREAM_MAX_LEVEL 52 /* lattice coordinates below 2^52 stay exact */
+
+void vpdsi_surface_stream_release(vpdsi_surface_stream *ss, vpdsi_mem *m)
+{
+    vpdsi_mem_free(m, ss->heap, ss->cap_heap * sizeof *ss->heap);
+    memset(ss, 0, sizeof *ss);
+}
+
+static void heap_sift_up(vpdsi_surface_heap_entry *h, size_t i)
+{
+    while (i > 0) {
+        size_t parent = (i - 1) / 2;
+        vpdsi_surface_heap_entry tmp;
+        if (!(h[i].ub > h[parent].ub)) return;
+        tmp = h[i];
+        h[i] = h[parent];
+        h[parent] = tmp;
+        i = parent;
+    }
+}
+
+static void heap_sift_down(vpdsi_surface_heap_entry *h, size_t n, size_t i)
+{
+    for (;;) {
+        size_t l = 2 * i + 1, r = l + 1, big = i;
+        vpdsi_surface_heap_entry tmp;
+        if (l < n && h[l].ub > h[big].ub) big = l;
+        if (r < n && h[r].ub > h[big].ub) big = r;
+        if (big == i) return;
+        tmp = h[i];
+        h[i] = h[big];
+        h[big] = tmp;
+        i = big;
+    }
+}
+
+/* The piece's centroid (parameters cuv, position c) and its farthest corner's distance. */
+static double piece_centre(const vpdsi_trimesh *mesh, const vpdsi_piece *p, double uv[3][2],
+                           double x[3][3], double *cuv, double *c)
+{
+    double h2 = 0;
+    int q, k;
+    vpdsi_piece_corners(mesh, 1, p, uv, x);
+    cuv[0] = (uv[0][0] + uv[1][0] + uv[2][0]) / 3;
+    cuv[1] = (uv[0][1] + uv[1][1] + uv[2][1]) / 3;
+    vpdsi_trimesh_point(mesh, p->tri, cuv, c);
+    for (q = 0; q < 3; q++) {
+        double d2 = 0;
+        for (k = 0; k < 3; k++) d2 += (x[q][k] - c[k]) * (x[q][k] - c[k]);
+        if (d2 > h2) h2 = d2;
+    }
+    return sqrt(h2) * (1 + 1e-12);
+}
+
+/* An upper bound of g over the piece: for y in it |y - x_i| <= |c - x_i| + h and
+ * f(r(x_i), r(y)) >= f(r(x_i), r_lo), f being non-decreasing (vpdsi_kd_min_ratio's slack form). */
+static vpds_status piece_upper_bound(const vpdsi_surface_stream_ctx *ctx, const vpdsi_piece *p, double *ub)
+{
+    vpdsi_kd_samples v = vpdsi_store_view(ctx->st);
+    double uv[3][2], x[3][3], cuv[2], c[3], r_lo, r_hi, h = piece_centre(ctx->mesh, p, uv, x, cuv, c);
+    int32_t arg;
+    vpds_status e = vpdsi_piece_bounds(ctx->mesh, ctx->st, p, uv, x, &r_lo, &r_hi);
+    if (e != VPDS_OK) return e;
+    *ub = vpdsi_kd_min_ratio(&ctx->st->tree, &v, c, h, r_lo, (int)ctx->rule, &arg);
+    return VPDS_OK;
+}
+
+/* The first sample, uniform by area over the surface (t = infinity), and every live triangle as
+ * a piece of the heap with an unknown (infinite) bound. */
+static vpds_status first_surface_sample(vpdsi_surface_stream *ss, const vpdsi_surface_stream_ctx *ctx,
+                                double *x_out, double *t_out)
+{
+    const vpdsi_trimesh *mesh = ctx->mesh;
+    vpdsi_rng before = *ctx->rng;
+    double total = 0, u, a, b, uv[2], x[3], r;
+    size_t k, pick = 0;
+    vpds_status e;
+    if (vpdsi_mem_reserve(ctx->st->mem, (void **)&ss->heap, &ss->cap_heap, mesh->n_live, sizeof *ss->heap)) {
+        vpdsi_store_error(ctx->st, "out of memory for the stream's %zu pieces", mesh->n_live);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    if ((e = vpdsi_marks_reserve(ctx->marks, ctx->st, 1)) != VPDS_OK) return e;
+    for (k = 0; k < mesh->n_live; k++) total += mesh->area[k];
+    u = vpdsi_rng_unit(ctx->rng) * total;
+    for (k = 0, total = 0; k < mesh->n_live; k++) {
+        total += mesh->area[k];
+        pick = k;
+        if (total > u) break;
+    }
+    a = vpdsi_rng_unit(ctx->rng);
+    b = vpdsi_rng_unit(ctx->rng);
+    if (a + b > 1) {
+        a = 1 - a;
+        b = 1 - b;
+    }
+    uv[0] = a;
+    uv[1] = b;
+    vpdsi_trimesh_point(mesh, (uint32_t)pick, uv, x);
+    if ((e = vpdsi_trimesh_radius(mesh, ctx->st, (uint32_t)pick, uv, x, &r)) != VPDS_OK) {
+        *ctx->rng = before;
+        return e;
+    }
+    for (k = 0; k < mesh->n_live; k++) {
+        memset(&ss->heap[k], 0, sizeof ss->heap[k]);
+        ss->heap[k].p.tri = (uint32_t)k;
+        ss->heap[k].ub = INFINITY;
+    }
+    ss->n_heap = mesh->n_live;
+    vpdsi_marks_append(ctx->marks, ctx->st, mesh, (uint32_t)pick, uv, x, r, INFINITY);
+    ctx->stats->accepted++;
+    ss->started = 1;
+    memcpy(x_out, x, 3 * sizeof *x);
+    *t_out = INFINITY;
+    return VPDS_OK;
+}
+
+/* The top piece holds the largest bound and it is current: accept its centroid, or split it. */
+static vpds_status settle_top(vpdsi_surface_stream *ss, const vpdsi_surface_stream_ctx *ctx,
+                              double ub, int *placed, double *x_out)
+{
+    vpdsi_piece p = ss->heap[0].p;
+    double uv[3][2], x[3][3], cuv[2], c[3], r, g;
+    int32_t arg;
+    int q;
+    vpds_status e;
+    vpdsi_kd_samples v = vpdsi_store_view(ctx->st);
+    piece_centre(ctx->mesh, &p, uv, x, cuv, c);
+    if ((e = vpdsi_trimesh_radius(ctx->mesh, ctx->st, p.tri, cuv, c, &r)) != VPDS_OK) return e;
+    g = vpdsi_kd_min_ratio(&ctx->st->tree, &v, c, 0, r, (int)ctx->rule, &arg);
+    if (!ctx->mesh->vr && ctx->st->sizing.kind != VPDSI_SIZING_CONSTANT && arg >= 0) {
+        /* the bounds trust the declared L: check it against the nearest sample */
+        const double *xa = ctx->st->x + 3 * (size_t)arg;
+        double d = sqrt((c[0] - xa[0]) * (c[0] - xa[0]) + (c[1] - xa[1]) * (c[1] - xa[1]) +
+                        (c[2] - xa[2]) * (c[2] - xa[2]));
+        if (fabs(r - ctx->st->r[arg]) > ctx->st->sizing.lipschitz * d * (1 + 1e-9) + 1e-300)
+            return vpdsi_store_lipschitz_broken(ctx->st, c, r, arg);
+    }
+    *placed = 0;
+    if (g >= ub * (1 - VPDS_STREAM_TOLERANCE) || p.level >= STREAM_MAX_LEVEL ||
+        vpdsi_piece_edge(ctx->mesh, 1, &p) < 2 * ctx->mesh->min_edge) {
+        if ((e = vpdsi_marks_reserve(ctx->marks, ctx->st, 1)) != VPDS_OK) return e;
+        vpdsi_marks_append(ctx->marks, ctx->st, ctx->mesh, p.tri, cuv, c, r, ub / ctx->coverage);
+        ctx->stats->accepted++;
+        memcpy(x_out, c, sizeof c);
+        *placed = 1;
+        return VPDS_OK;
+    }
+    if (vpdsi_mem_reserve(ctx->st->mem, (void **)&ss->heap, &ss->cap_heap, ss->n_heap + 3, sizeof *ss->heap)) {
+        vpdsi_store_error(ctx->st, "out of memory for the stream's %zu pieces", ss->n_heap + 3);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    /* the children keep the parent's bound (they lie in it) until they reach the top */
+    ss->heap[0].p = vpdsi_piece_child(&p, 0);
+    for (q = 1; q < 4; q++) {
+        ss->heap[ss->n_heap].p = vpdsi_piece_child(&p, q);
+        ss->heap[ss->n_heap].ub = ub;
+        heap_sift_up(ss->heap, ss->n_heap++);
+    }
+    if (p.level + 1u > ctx->stats->levels) ctx->stats->levels = p.level + 1u;
+    return VPDS_OK;
+}
+
+vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_stream_ctx *ctx,
+                               double t_min, double *x_out, double *t_out)
+{
+    if (!ss->started) return first_surface_sample(ss, ctx, x_out, t_out);
+    for (;;) {
+        double ub;
+        int placed = 0;
+        vpds_status e = piece_upper_bound(ctx, &ss->heap[0].p, &ub);
+        if (e != VPDS_OK) return e;
+        if (ub < ss->heap[0].ub) {
+            /* a sample came nearer since the bound was taken: it falls back in the heap */
+            ss->heap[0].ub = ub;
+            heap_sift_down(ss->heap, ss->n_heap, 0);
+            continue;
+        }
+        if (!(ub / ctx->coverage > t_min)) return VPDS_STREAM_END;
+        if ((e = settle_top(ss, ctx, ub, &placed, x_out)) != VPDS_OK) return e;
+        if (placed) {
+            *t_out = ub / ctx->coverage;
+            return VPDS_OK;
+        }
+    }
+}

@@ -1,0 +1,39 @@
+/* The continuous stream on a surface (Section 4.2 carried to meshes): each call inserts the
+ * point of the surface farthest from the samples in the rule's scaled distance
+ * g(y) = min_i |y - x_i| / f(r(x_i), r(y)), found by branch and bound over pieces: a max-heap of
+ * pieces keyed by an upper bound of g over each (kept lazily: bounds only fall as samples come),
+ * the top one refreshed, then accepted at its centroid when g there is within
+ * VPDS_STREAM_TOLERANCE of the bound, else split in four. The first sample is uniform by area. */
+#ifndef VPDS_SURFACE_STREAM_H
+#define VPDS_SURFACE_STREAM_H
+#include "pieces.h"
+#include "rng.h"
+
+typedef struct vpdsi_surface_heap_entry {
+    vpdsi_piece p;
+    double ub;               /* an upper bound of g over the piece */
+} vpdsi_surface_heap_entry;
+
+typedef struct vpdsi_surface_stream {
+    int started;             /* the first sample is placed */
+    vpdsi_surface_heap_entry *heap;
+    size_t n_heap, cap_heap;
+} vpdsi_surface_stream;
+
+/* What a call reads and writes. */
+typedef struct vpdsi_surface_stream_ctx {
+    const vpdsi_trimesh *mesh;
+    vpdsi_store *st;          /* in kd-tree mode */
+    vpdsi_surface_marks *marks;
+    vpdsi_rng *rng;
+    vpds_stats *stats;
+    vpds_rule rule;           /* resolved */
+    double coverage;          /* = inhibition */
+} vpdsi_surface_stream_ctx;
+
+void vpdsi_surface_stream_release(vpdsi_surface_stream *ss, vpdsi_mem *m);
+/* The next sample into x_out (3 doubles), its scale into *t_out: VPDS_OK, or VPDS_STREAM_END when
+ * its scale would be at or below t_min (nothing consumed), or an error (nothing consumed). */
+vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_stream_ctx *ctx,
+                               double t_min, double *x_out, double *t_out);
+#endif
