@@ -116,64 +116,87 @@ static vpds_status first_surface_sample(vpdsi_surface_stream *ss, const vpdsi_su
     vpdsi_marks_append(ctx->marks, ctx->st, mesh, (uint32_t)pick, uv, x, r, INFINITY);
     ctx->stats->accepted++;
     ss->started = 1;
+    ss->best.g = -1;
     memcpy(x_out, x, 3 * sizeof *x);
     *t_out = INFINITY;
     return VPDS_OK;
 }
 
-/* The top piece holds the largest bound and it is current: accept its centroid, or split it. */
-static vpds_status settle_top(vpdsi_surface_stream *ss, const vpdsi_surface_stream_ctx *ctx,
-                              double ub, int *placed, double *x_out)
+/* g at the piece's centroid (r there exact); a better point than *best replaces it. With a sizing
+ * callback the bounds trust the declared L: it is checked against the nearest sample. */
+static vpds_status look_at_centre(const vpdsi_surface_stream_ctx *ctx, const vpdsi_piece *p, vpdsi_surface_best *best)
 {
-    vpdsi_piece p = ss->heap[0].p;
+    vpdsi_kd_samples v = vpdsi_store_view(ctx->st);
     double uv[3][2], x[3][3], cuv[2], c[3], r, g;
     int32_t arg;
-    int q;
     vpds_status e;
-    vpdsi_kd_samples v = vpdsi_store_view(ctx->st);
-    piece_centre(ctx->mesh, &p, uv, x, cuv, c);
-    if ((e = vpdsi_trimesh_radius(ctx->mesh, ctx->st, p.tri, cuv, c, &r)) != VPDS_OK) return e;
+    piece_centre(ctx->mesh, p, uv, x, cuv, c);
+    if ((e = vpdsi_trimesh_radius(ctx->mesh, ctx->st, p->tri, cuv, c, &r)) != VPDS_OK) return e;
     g = vpdsi_kd_min_ratio(&ctx->st->tree, &v, c, 0, r, (int)ctx->rule, &arg);
     if (!ctx->mesh->vr && ctx->st->sizing.kind != VPDSI_SIZING_CONSTANT && arg >= 0) {
-        /* the bounds trust the declared L: check it against the nearest sample */
         const double *xa = ctx->st->x + 3 * (size_t)arg;
         double d = sqrt((c[0] - xa[0]) * (c[0] - xa[0]) + (c[1] - xa[1]) * (c[1] - xa[1]) +
                         (c[2] - xa[2]) * (c[2] - xa[2]));
         if (fabs(r - ctx->st->r[arg]) > ctx->st->sizing.lipschitz * d * (1 + 1e-9) + 1e-300)
             return vpdsi_store_lipschitz_broken(ctx->st, c, r, arg);
     }
-    *placed = 0;
-    if (g >= ub * (1 - VPDS_STREAM_TOLERANCE) || p.level >= STREAM_MAX_LEVEL ||
-        vpdsi_piece_edge(ctx->mesh, 1, &p) < 2 * ctx->mesh->min_edge) {
-        if ((e = vpdsi_marks_reserve(ctx->marks, ctx->st, 1)) != VPDS_OK) return e;
-        vpdsi_marks_append(ctx->marks, ctx->st, ctx->mesh, p.tri, cuv, c, r, ub / ctx->coverage);
-        ctx->stats->accepted++;
-        memcpy(x_out, c, sizeof c);
-        *placed = 1;
-        return VPDS_OK;
+    if (g > best->g) {
+        best->g = g;
+        best->r = r;
+        best->tri = p->tri;
+        memcpy(best->uv, cuv, sizeof cuv);
+        memcpy(best->x, c, sizeof c);
     }
+    return VPDS_OK;
+}
+
+/* Split the top piece (bound ub) into its four children, each with its own bound and its centre
+ * looked at; nothing changes on failure. */
+static vpds_status split_top(vpdsi_surface_stream *ss, const vpdsi_surface_stream_ctx *ctx, double ub,
+                             vpdsi_surface_best *best)
+{
+    vpdsi_piece p = ss->heap[0].p, child[4];
+    double cub[4];
+    vpdsi_surface_best keep = *best;
+    int q;
+    vpds_status e;
     if (vpdsi_mem_reserve(ctx->st->mem, (void **)&ss->heap, &ss->cap_heap, ss->n_heap + 3, sizeof *ss->heap)) {
         vpdsi_store_error(ctx->st, "out of memory for the stream's %zu pieces", ss->n_heap + 3);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
-    /* the children keep the parent's bound (they lie in it) until they reach the top */
-    ss->heap[0].p = vpdsi_piece_child(&p, 0);
+    for (q = 0; q < 4; q++) {
+        child[q] = vpdsi_piece_child(&p, q);
+        if ((e = piece_upper_bound(ctx, &child[q], &cub[q])) != VPDS_OK ||
+            (e = look_at_centre(ctx, &child[q], best)) != VPDS_OK) {
+            *best = keep;
+            return e;
+        }
+        if (cub[q] > ub) cub[q] = ub; /* the child lies in its parent */
+    }
+    ss->heap[0].p = child[0];
+    ss->heap[0].ub = cub[0];
+    heap_sift_down(ss->heap, ss->n_heap, 0);
     for (q = 1; q < 4; q++) {
-        ss->heap[ss->n_heap].p = vpdsi_piece_child(&p, q);
-        ss->heap[ss->n_heap].ub = ub;
+        ss->heap[ss->n_heap].p = child[q];
+        ss->heap[ss->n_heap].ub = cub[q];
         heap_sift_up(ss->heap, ss->n_heap++);
     }
     if (p.level + 1u > ctx->stats->levels) ctx->stats->levels = p.level + 1u;
     return VPDS_OK;
 }
 
+static int may_split(const vpdsi_surface_stream_ctx *ctx, const vpdsi_piece *p)
+{
+    return p->level < STREAM_MAX_LEVEL && vpdsi_piece_edge(ctx->mesh, 1, p) >= 2 * ctx->mesh->min_edge;
+}
+
 vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_stream_ctx *ctx,
                                double t_min, double *x_out, double *t_out)
 {
+    vpdsi_surface_best *best = &ss->best;
     if (!ss->started) return first_surface_sample(ss, ctx, x_out, t_out);
     for (;;) {
         double ub;
-        int placed = 0;
         vpds_status e = piece_upper_bound(ctx, &ss->heap[0].p, &ub);
         if (e != VPDS_OK) return e;
         if (ub < ss->heap[0].ub) {
@@ -183,10 +206,18 @@ vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_str
             continue;
         }
         if (!(ub / ctx->coverage > t_min)) return VPDS_STREAM_END;
-        if ((e = settle_top(ss, ctx, ub, &placed, x_out)) != VPDS_OK) return e;
-        if (placed) {
+        /* ub bounds g over the whole surface: a point within the tolerance of it is the next */
+        if ((e = look_at_centre(ctx, &ss->heap[0].p, best)) != VPDS_OK) return e;
+        if (best->g >= ub * (1 - VPDS_STREAM_TOLERANCE) || !may_split(ctx, &ss->heap[0].p)) {
+            if ((e = vpdsi_marks_reserve(ctx->marks, ctx->st, 1)) != VPDS_OK) return e;
+            vpdsi_marks_append(ctx->marks, ctx->st, ctx->mesh, best->tri, best->uv, best->x, best->r,
+                               ub / ctx->coverage);
+            ctx->stats->accepted++;
+            memcpy(x_out, best->x, sizeof best->x);
             *t_out = ub / ctx->coverage;
+            best->g = -1; /* new sample: every g seen is stale */
             return VPDS_OK;
         }
+        if ((e = split_top(ss, ctx, ub, best)) != VPDS_OK) return e;
     }
 }

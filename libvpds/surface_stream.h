@@ -14,8 +14,15 @@ typedef struct vpdsi_surface_heap_entry {
     double ub;               /* an upper bound of g over the piece */
 } vpdsi_surface_heap_entry;
 
+/* The best point seen since the last sample was placed: g there, r, and where. */
+typedef struct vpdsi_surface_best {
+    double g, r, uv[2], x[3];
+    uint32_t tri;
+} vpdsi_surface_best;
+
 typedef struct vpdsi_surface_stream {
     int started;             /* the first sample is placed */
+    vpdsi_surface_best best; /* kept across calls that fail or end: the samples are the same */
     vpdsi_surface_heap_entry *heap;
     size_t n_heap, cap_heap;
 } vpdsi_surface_stream;
