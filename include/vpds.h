@@ -464,6 +464,8 @@ VPDS_API int vpds_tiled_threads(const vpds_tiled *tiled);
  * that is free when it is placed (Algorithm 1: active pieces are sub-triangles split at their
  * edge midpoints into four of equal area; a dart picks a piece with probability proportional to
  * its area, then a uniform point of it).
+ * Pieces below 2^-40 of a disk's area split only once nothing larger is active, so a sliver far
+ * from everything is covered too. The index is the box of the live triangles' corners.
  * A triangle whose area is below 2^-40 of its longest edge squared is degenerate: it is not part
  * of S, gets no darts and is not checked for coverage (its points lie on a segment; where that is
  * another triangle's edge they are covered there). A mesh of degenerate triangles only is refused.
@@ -508,7 +510,9 @@ VPDS_API const char *vpds_mesh_last_error(const vpds_mesh *mesh);
  * An error (out of memory, a bad sizing value) leaves the mesh as a pause would. */
 VPDS_API vpds_status vpds_mesh_run(vpds_mesh *mesh);
 /* Continue a completed run down to the smaller scale t (0 < t < the current one): the samples
- * kept, new ones added until maximal at t (Section 4.1). */
+ * kept, new ones added until maximal at t (Section 4.1). Before any run, the first run's scale
+ * (any t > 0); t equal to the current scale continues it (nothing to do once complete). A scale
+ * refused for its size (VPDS_ERR_OVERFLOW) leaves the mesh as it was. */
 VPDS_API vpds_status vpds_mesh_refine(vpds_mesh *mesh, double t);
 /* The continuous stream on the surface (exactly n points: call it n times): the point farthest
  * from the samples in the rule's scaled distance, found by branch and bound, with its scale t

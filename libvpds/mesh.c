@@ -70,47 +70,62 @@ static vpds_desc sizing_desc(const vpds_mesh_desc *d)
     return b;
 }
 
-/* Area and longest edge of triangle t. */
-static void triangle_shape(const double *v, const uint32_t *t, double *area, double *longest)
+/* The edges of triangle t divided by their largest coordinate difference *m (0: one point), so
+ * that squares neither overflow nor underflow whatever the triangle's size. */
+static void scaled_edges(const double *v, const uint32_t *t, double e[3][3], double *m)
 {
     const double *a = v + 3 * (size_t)t[0], *b = v + 3 * (size_t)t[1], *c = v + 3 * (size_t)t[2];
-    double e1[3], e2[3], e3[3], cr[3], l1 = 0, l2 = 0, l3 = 0;
-    int k;
+    int k, q;
+    *m = 0;
     for (k = 0; k < 3; k++) {
-        e1[k] = b[k] - a[k];
-        e2[k] = c[k] - a[k];
-        e3[k] = c[k] - b[k];
-        l1 += e1[k] * e1[k];
-        l2 += e2[k] * e2[k];
-        l3 += e3[k] * e3[k];
+        e[0][k] = b[k] - a[k];
+        e[1][k] = c[k] - a[k];
+        e[2][k] = c[k] - b[k];
+        for (q = 0; q < 3; q++) *m = fabs(e[q][k]) > *m ? fabs(e[q][k]) : *m;
     }
-    cr[0] = e1[1] * e2[2] - e1[2] * e2[1];
-    cr[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    cr[2] = e1[0] * e2[1] - e1[1] * e2[0];
-    *area = 0.5 * sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
-    *longest = sqrt(l1 > l2 ? (l1 > l3 ? l1 : l3) : (l2 > l3 ? l2 : l3));
+    for (q = 0; *m > 0 && q < 3; q++)
+        for (k = 0; k < 3; k++) e[q][k] /= *m;
 }
 
-static int degenerate(double area, double longest)
+/* Area, longest edge and shape (area / longest^2, scale-free) of triangle t. */
+static void triangle_shape(const double *v, const uint32_t *t, double *area, double *longest, double *shape)
 {
-    return !(longest > 0) || !(area > DEGENERATE_AREA * longest * longest);
+    double e[3][3], m, cr[3], l2 = 0;
+    int q;
+    scaled_edges(v, t, e, &m);
+    for (q = 0; q < 3; q++) {
+        double d = e[q][0] * e[q][0] + e[q][1] * e[q][1] + e[q][2] * e[q][2];
+        if (d > l2) l2 = d;
+    }
+    cr[0] = e[0][1] * e[1][2] - e[0][2] * e[1][1];
+    cr[1] = e[0][2] * e[1][0] - e[0][0] * e[1][2];
+    cr[2] = e[0][0] * e[1][1] - e[0][1] * e[1][0];
+    *shape = l2 > 0 ? 0.5 * sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]) / l2 : 0;
+    *longest = m * sqrt(l2);
+    *area = *shape * *longest * *longest;
 }
 
-/* |grad r| of the vertex radii over triangle t (of area > 0): r linear in the triangle's plane,
- * |g|^2 = dr^T G^-1 dr with G the Gram matrix of two edges, det G = 4 area^2. */
-static double radius_slope(const double *v, const double *vr, const uint32_t *t, double area)
+static int degenerate(double shape, double longest)
 {
-    const double *a = v + 3 * (size_t)t[0], *b = v + 3 * (size_t)t[1], *c = v + 3 * (size_t)t[2];
-    double g11 = 0, g12 = 0, g22 = 0, d1 = vr[t[1]] - vr[t[0]], d2 = vr[t[2]] - vr[t[0]], q;
+    return !(longest > 0) || !(shape > DEGENERATE_AREA);
+}
+
+/* |grad r| of the vertex radii over triangle t (not degenerate): r linear in the triangle's
+ * plane, |g|^2 = dr^T G^-1 dr with G the Gram matrix of two edges (in units of m), det G the
+ * squared cross product. */
+static double radius_slope(const double *v, const double *vr, const uint32_t *t)
+{
+    double e[3][3], m, g11 = 0, g12 = 0, g22 = 0, d1 = vr[t[1]] - vr[t[0]], d2 = vr[t[2]] - vr[t[0]], q, det;
     int k;
+    scaled_edges(v, t, e, &m);
     for (k = 0; k < 3; k++) {
-        double e1 = b[k] - a[k], e2 = c[k] - a[k];
-        g11 += e1 * e1;
-        g12 += e1 * e2;
-        g22 += e2 * e2;
+        g11 += e[0][k] * e[0][k];
+        g12 += e[0][k] * e[1][k];
+        g22 += e[1][k] * e[1][k];
     }
-    q = (d1 * d1 * g22 - 2 * d1 * d2 * g12 + d2 * d2 * g11) / (4 * area * area);
-    return q > 0 ? sqrt(q) : 0;
+    det = g11 * g22 - g12 * g12;
+    q = det > 0 ? (d1 * d1 * g22 - 2 * d1 * d2 * g12 + d2 * d2 * g11) / det : INFINITY;
+    return q > 0 ? sqrt(q) / m : 0;
 }
 
 static vpds_status validate_arrays(const vpds_mesh_desc *d, char *msg, size_t cap)
@@ -140,18 +155,18 @@ static vpds_status validate_arrays(const vpds_mesh_desc *d, char *msg, size_t ca
                              "[1e-100, 1e100] (> 0)", i, d->vertex_radii[i]);
     for (i = 0; i < d->n_triangles; i++) {
         const uint32_t *t = d->triangles + 3 * i;
-        double area, longest;
+        double area, longest, shape;
         for (k = 0; k < 3; k++)
             if (t[k] >= d->n_vertices)
                 VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.triangles: triangle %zu corner %d is vertex %u, "
                              "out of range (n_vertices = %zu)", i, k, (unsigned)t[k], d->n_vertices);
-        triangle_shape(d->vertices, t, &area, &longest);
+        triangle_shape(d->vertices, t, &area, &longest, &shape);
         if (!isfinite(area) || !isfinite(longest))
             VPDSI_REFUSE(VPDS_ERR_OVERFLOW, "desc.triangles: triangle %zu: its area or edges overflow", i);
-        if (degenerate(area, longest)) continue;
+        if (degenerate(shape, longest)) continue;
         n_live++;
         if (d->vertex_radii) {
-            double L = radius_slope(d->vertices, d->vertex_radii, t, area) * d->coverage;
+            double L = radius_slope(d->vertices, d->vertex_radii, t) * d->coverage;
             double limit = vpdsi_rule_max_lipschitz(vpdsi_rule_resolve(d->rule));
             if (!(L < limit))
                 VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.vertex_radii: over triangle %zu r changes with "
@@ -234,17 +249,19 @@ static vpds_status take_arrays(vpds_mesh *s, const vpds_mesh_desc *d, double *lo
         return VPDS_ERR_OUT_OF_MEMORY;
     }
     for (i = 0; i < s->n_tri; i++) {
-        double area, longest;
-        triangle_shape(s->v, s->tri + 3 * i, &area, &longest);
-        if (degenerate(area, longest)) continue;
+        double area, longest, shape;
+        triangle_shape(s->v, s->tri + 3 * i, &area, &longest, &shape);
+        if (degenerate(shape, longest)) continue;
         s->live[n] = (uint32_t)i;
         s->area[n] = area;
         s->longest[n++] = longest;
     }
-    for (k = 0; k < 3; k++) lo[k] = hi[k] = s->v[k];
-    for (i = 0; i < s->n_v; i++)
+    /* the box and the precision of the sampled set: the corners of the live triangles (a vertex
+     * no live triangle uses would widen the index's box for nothing) */
+    for (k = 0; k < 3; k++) lo[k] = hi[k] = s->v[3 * (size_t)s->tri[3 * (size_t)s->live[0]] + (size_t)k];
+    for (i = 0; i < 3 * n; i++)
         for (k = 0; k < 3; k++) {
-            double x = s->v[3 * i + (size_t)k];
+            double x = s->v[3 * (size_t)s->tri[3 * (size_t)s->live[i / 3] + i % 3] + (size_t)k];
             if (x < lo[k]) lo[k] = x;
             if (x > hi[k]) hi[k] = x;
             if (fabs(x) > mag) mag = fabs(x);

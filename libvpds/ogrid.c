@@ -20,6 +20,9 @@ int vpdsi_ogrid_setup(vpdsi_ogrid *g, int dim, const double *lo, const double *h
         if (hi[k] - lo[k] > ext) ext = hi[k] - lo[k];
     }
     if (!(top > 0)) top = ext;
+    /* a box wider than 2^BITS cells of the largest radius: coordinates would be clamped and
+     * samples filed where queries do not look */
+    if (!(ext / top < (double)CELL_MAX)) return -2;
     /* levels while a cell coordinate fits its bits; smaller radii share the last level */
     for (l = 0; l < VPDSI_OGRID_LEVELS; l++) {
         double side = ldexp(top, -l);

@@ -30,7 +30,8 @@ typedef struct vpdsi_ogrid {
     size_t cap_next;
 } vpdsi_ogrid;
 
-/* Lay out over the box [lo, hi] for radii up to about top; -1 when dim > 3 (nothing held). */
+/* Lay out over the box [lo, hi] for radii up to about top; -1 when dim > 3, -2 when the box is
+ * 2^BITS cells of side top wide or more (nothing held either way). */
 int vpdsi_ogrid_setup(vpdsi_ogrid *g, int dim, const double *lo, const double *hi, double top);
 void vpdsi_ogrid_release(vpdsi_ogrid *g, vpdsi_mem *m);
 /* Room for `more` inserts, the grid then holding n_total samples; -1 on OOM (nothing lost). */

@@ -138,8 +138,11 @@ vpds_status vpdsi_store_use_ogrid(vpdsi_store *st, double top)
 {
     vpdsi_kd_samples v = vpdsi_store_view(st);
     size_t i;
+    int fit;
     vpdsi_store_drop_index(st);
-    if (vpdsi_ogrid_setup(&st->ogrid, st->dim, st->lo, st->hi, top)) {
+    if ((fit = vpdsi_ogrid_setup(&st->ogrid, st->dim, st->lo, st->hi, top)) == -2)
+        return vpdsi_store_sync_tree(st); /* too wide for the grid's cells: the kd-tree serves */
+    if (fit) {
         vpdsi_store_error(st, "the octave grid holds dim <= 3, not %d", st->dim);
         return VPDS_ERR_INVALID_ARGUMENT;
     }

@@ -52,8 +52,9 @@ vpds_status vpdsi_store_sync_tree(vpdsi_store *st);
 /* Append and index a sample (after vpdsi_store_reserve). */
 void vpdsi_store_append(vpdsi_store *st, const double *x, double r, double t, uint8_t flags);
 /* Index the samples (dim <= 3) with the octave grid (radii up to about top) until use_tree or
- * drop_index; queries then go through vpdsi_store_conflict and vpdsi_store_gather. On failure
- * the store is left with no accelerator (the kd-tree, maybe lagging). */
+ * drop_index; queries then go through vpdsi_store_conflict and vpdsi_store_gather. A box too
+ * wide for the grid's cells keeps the kd-tree (synced). On failure the store is left with no
+ * accelerator (the kd-tree, maybe lagging). */
 vpds_status vpdsi_store_use_ogrid(vpdsi_store *st, double top);
 /* Done at a scale: drop the background or octave grid (the kd-tree lags behind, synced when
  * next needed). */

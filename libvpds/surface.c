@@ -10,8 +10,9 @@
 #define DARTS_PER_PIECE 0.5
 #define PIECE_CHUNK 256                /* darts or pieces between checks of the budget */
 #define PIECE_MAX_LEVEL 52             /* lattice coordinates i * 2^-level stay exact doubles */
-/* a piece smaller than this fraction of a disk's area never splits: darts, which land by
- * area, would not find it (a sliver's pieces keep its shape) */
+/* a piece smaller than this fraction of a disk's area does not split while larger pieces are
+ * active (a sliver's pieces keep its shape: split while darts go elsewhere, they would multiply
+ * without end); once only such pieces are left, every dart lands on them and they split too */
 #define MIN_AREA_FRACTION 9.094947017729282e-13 /* 2^-40 */
 #define SEED_COUNT_MAX 1099511627776.0          /* 2^40 seed pieces (never stored): refused beyond */
 #define SEED_EDGE_MAX 67108864.0                /* 2^26 per edge: lattice coordinates stay exact */
@@ -47,6 +48,9 @@ void vpdsi_surface_release(vpdsi_surface *s, vpdsi_mem *m)
 
 void vpdsi_surface_begin(vpdsi_surface *s, double t)
 {
+    s->prev_t = s->t;
+    s->prev_phase = s->phase;
+    s->floor_lifted = 0;
     s->t = t;
     s->phase = VPDSI_SURF_SEED;
     s->pos = 0;
@@ -59,9 +63,10 @@ static int splittable(const vpdsi_surface_ctx *ctx, const vpdsi_surface *s, cons
                       double r_hi)
 {
     double reach = s->t * ctx->coverage * r_hi;
-    return p->level + vpdsi_lattice_bits(s->seed_m[p->tri]) < PIECE_MAX_LEVEL &&
-           vpdsi_piece_edge(ctx->mesh, s->seed_m[p->tri], p) >= 2 * ctx->mesh->min_edge &&
-           vpdsi_piece_area(ctx->mesh, s->seed_m[p->tri], p) >= MIN_AREA_FRACTION * reach * reach;
+    uint64_t m = s->seed_m[p->tri];
+    return p->level + vpdsi_lattice_bits(m) < PIECE_MAX_LEVEL &&
+           vpdsi_piece_edge(ctx->mesh, m, p) >= 2 * ctx->mesh->min_edge &&
+           (s->floor_lifted || vpdsi_piece_area(ctx->mesh, m, p) >= MIN_AREA_FRACTION * reach * reach);
 }
 
 /* ---- coverage ---- */
@@ -174,7 +179,8 @@ static vpds_status seed_radius(const vpdsi_surface_ctx *ctx, uint32_t k, double 
         return VPDS_OK;
     }
     for (q = 0; q < 3; q++)
-        c[q] = (mesh->v[3 * (size_t)t[0] + q] + mesh->v[3 * (size_t)t[1] + q] + mesh->v[3 * (size_t)t[2] + q]) / 3;
+        c[q] = (mesh->v[3 * (size_t)t[0] + q] + mesh->v[3 * (size_t)t[1] + q] +
+                mesh->v[3 * (size_t)t[2] + q]) / 3;
     return vpdsi_trimesh_radius(ctx->mesh, ctx->st, k, uv, c, r);
 }
 
@@ -240,6 +246,10 @@ static vpds_status seed_step(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, uin
                               "(the mesh needs more than %.0f in all, or the radius is too small for "
                               "its triangles); the count overflows", s->t, (unsigned)mesh->live[s->pos],
                               m * m, SEED_COUNT_MAX);
+            /* refused for good at this scale: back to the state before (a completed run stays) */
+            release_pieces(s, ctx->st->mem);
+            s->t = s->prev_t;
+            s->phase = s->prev_phase;
             s->pos = 0;
             return VPDS_ERR_OVERFLOW;
         }
@@ -302,8 +312,9 @@ static void draw_piece_dart(const vpdsi_surface *s, const vpdsi_surface_ctx *ctx
         b = 1 - b;
     }
     *tri = p.tri;
-    uv[0] = s->implicit ? a : ((double)p.i + a) * scale;
-    uv[1] = s->implicit ? b : ((double)p.j + b) * scale;
+    /* i * scale + a * scale keeps the low bits of a, which i + a would round away deep down */
+    uv[0] = s->implicit ? a : (double)p.i * scale + a * scale;
+    uv[1] = s->implicit ? b : (double)p.j * scale + b * scale;
     t = mesh->tri + 3 * (size_t)mesh->live[p.tri];
     va = mesh->v + 3 * (size_t)t[0], vb = mesh->v + 3 * (size_t)t[1], vc = mesh->v + 3 * (size_t)t[2];
     for (q = 0; q < 3; q++) x[q] = va[q] + uv[0] * (vb[q] - va[q]) + uv[1] * (vc[q] - va[q]);
@@ -390,7 +401,8 @@ static vpds_status sweep_one_piece(vpdsi_surface *s, const vpdsi_surface_ctx *ct
         vpdsi_piece_corners(ctx->mesh, s->seed_m[c.tri], &c, cuv, cx);
         /* a child lies in its parent: the parent's bounds hold, vertex radii's exact ones are
          * tighter */
-        if (ctx->mesh->vr && (e = vpdsi_piece_bounds(ctx->mesh, ctx->st, &c, cuv, cx, &c_lo, &c_hi)) != VPDS_OK) return e;
+        if (ctx->mesh->vr && (e = vpdsi_piece_bounds(ctx->mesh, ctx->st, &c, cuv, cx, &c_lo, &c_hi)) != VPDS_OK)
+            return e;
         if (!corners_covered(s, ctx, cx, c_lo)) s->next[s->n_next++] = c;
         if (c.level + 1u > ctx->stats->levels) ctx->stats->levels = c.level + 1u;
     }
@@ -440,6 +452,11 @@ static void finish_piece_sweep(vpdsi_surface *s, const vpdsi_surface_ctx *ctx)
     if (s->n_cur == 0) {
         ctx->stats->delta = 0;
         s->phase = VPDSI_SURF_DONE;
+    } else if (!was_filter && !s->split_any && !s->floor_lifted) {
+        /* only pieces below the area floor are left: every dart now lands on them, so they may
+         * split after all (down to the coordinates' precision) */
+        s->floor_lifted = 1;
+        begin_piece_darts(s, DARTS_PER_SEED_PIECE, (double)s->n_cur);
     } else if (!was_filter && !s->split_any) {
         double worst = 0;
         for (k = 0; k < s->n_cur; k++) {

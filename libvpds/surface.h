@@ -16,6 +16,9 @@ typedef enum {
 typedef struct vpdsi_surface {
     vpdsi_surf_phase phase;
     double t;                            /* scale being sampled */
+    double prev_t;                       /* the scale and phase before vpdsi_surface_begin */
+    vpdsi_surf_phase prev_phase;
+    int floor_lifted;                    /* only pieces below the area floor were left */
     uint64_t *seed_m;                    /* per live triangle: m, its seed pieces per edge */
     double *tri_cum;                     /* running sums of the live triangles' areas */
     size_t cap_seed_m, cap_tri_cum;

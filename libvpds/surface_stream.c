@@ -124,7 +124,8 @@ static vpds_status first_surface_sample(vpdsi_surface_stream *ss, const vpdsi_su
 
 /* g at the piece's centroid (r there exact); a better point than *best replaces it. With a sizing
  * callback the bounds trust the declared L: it is checked against the nearest sample. */
-static vpds_status look_at_centre(const vpdsi_surface_stream_ctx *ctx, const vpdsi_piece *p, vpdsi_surface_best *best)
+static vpds_status look_at_centre(const vpdsi_surface_stream_ctx *ctx, const vpdsi_piece *p,
+                                  vpdsi_surface_best *best)
 {
     vpdsi_kd_samples v = vpdsi_store_view(ctx->st);
     double uv[3][2], x[3][3], cuv[2], c[3], r, g;

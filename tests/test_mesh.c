@@ -960,6 +960,128 @@ static void test_stream(void)
     mesh_free(&sq);
 }
 
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static double sizing_wave(const double *x, void *u)
+{
+    (void)u;
+    return 0.055 + 0.005 * sin(x[0]);
+}
+
+/* The octave grid holds 2^19 cells of the largest radius per axis: a wider box (a mesh with a
+ * far-away triangle, an unused vertex far away, a long 1D box) falls back to the kd-tree, with
+ * every guarantee; an unused vertex changes nothing. */
+static void test_wide_extent(void)
+{
+    mesh_t one = {0}, stray = {0}, apart = {0};
+    vpds_mesh_desc d;
+    vpds_mesh *a, *b;
+    size_t i;
+    square_part(&one, 0, 1, 1, 1, 0, 0, 1);
+    square_part(&stray, 0, 1, 1, 1, 0, 0, 1);
+    add_v(&stray, -3e4, 0, 0); /* used by no triangle */
+    square_part(&apart, 0, 1, 1, 1, 0, 0, 1);
+    square_part(&apart, 3e4, 3e4 + 1, 1, 1, 0, 0, 1);
+    r_const_val = 0.05;
+    d = desc_for(&one);
+    d.radius = r_const_val;
+    a = run_mesh(&d);
+    d = desc_for(&stray);
+    d.radius = r_const_val;
+    b = run_mesh(&d);
+    CHECK_MSG(a && b && same_samples(a, b), "an unused vertex far away changed the samples (%zu, %zu)",
+              vpds_mesh_count(a), vpds_mesh_count(b));
+    vpds_mesh_destroy(a);
+    vpds_mesh_destroy(b);
+    d = desc_for(&apart);
+    d.radius = r_const_val;
+    if ((a = run_mesh(&d))) {
+        expect_guarantees("3e4 apart", check_mesh_run(a, &apart, NULL, r_const, d.rule, 1, 0.05, 0.05),
+                          vpds_mesh_count(a));
+        CHECK(vpds_mesh_count(a) < 1000);
+        vpds_mesh_destroy(a);
+    }
+    if (!quick) {
+        /* a box 640,000 radii long with a varying radius (the octave grid's own case) */
+        vpds_desc bd = vpds_default_desc();
+        double lo = 0, hi = 3.5e4, *x;
+        vpds_sampler *s;
+        size_t n, bad = 0;
+        bd.dim = 1;
+        bd.lo = &lo;
+        bd.hi = &hi;
+        bd.sizing = sizing_wave;
+        bd.lipschitz = 0.005;
+        bd.seed = 3;
+        CHECK(vpds_create(&bd, &s) == VPDS_OK && vpds_run(s) == VPDS_OK);
+        n = vpds_count(s);
+        x = (double *)malloc(n * sizeof *x);
+        memcpy(x, vpds_points(s), n * sizeof *x);
+        qsort(x, n, sizeof *x, cmp_double);
+        for (i = 1; i < n; i++) {
+            double gap = x[i] - x[i - 1], rl = sizing_wave(x + i - 1, NULL), rr = sizing_wave(x + i, NULL);
+            double mid = 0.5 * (x[i] + x[i - 1]), rm = sizing_wave(&mid, NULL);
+            bad += gap < (rl < rr ? rl : rr) * (1 - 1e-12);                       /* a conflict */
+            bad += gap / 2 > (rm < rl ? rm : rl) * (1 + 1e-9) && gap / 2 > (rm < rr ? rm : rr) * (1 + 1e-9);
+        }
+        CHECK_MSG(n > 400000 && bad == 0, "1D box of 3.5e4: %zu samples, %zu bad gaps", n, bad);
+        free(x);
+        vpds_destroy(s);
+    }
+    mesh_free(&one);
+    mesh_free(&stray);
+    mesh_free(&apart);
+}
+
+/* A sliver far thinner than a disk but above the degenerate threshold, alone: its pieces stop
+ * splitting early, darts still come to them until they are covered. */
+static void test_lone_sliver(void)
+{
+    mesh_t m = {0};
+    int seed;
+    add_v(&m, 0, 0, 0);
+    add_v(&m, 1, 0, 0);
+    add_v(&m, 0.5, 1e-10, 0);
+    add_t(&m, 0, 1, 2);
+    r_const_val = 0.05;
+    for (seed = 0; seed < (quick ? 2 : 6); seed++) {
+        vpds_mesh_desc d = desc_for(&m);
+        vpds_mesh *s;
+        d.radius = r_const_val;
+        d.seed = (uint64_t)seed;
+        if ((s = run_mesh(&d))) {
+            expect_guarantees("lone sliver", check_mesh_run(s, &m, NULL, r_const, d.rule, 1, 0.05, 0.05),
+                              vpds_mesh_count(s));
+            vpds_mesh_destroy(s);
+        }
+    }
+    mesh_free(&m);
+}
+
+/* A refinement refused for its size leaves the completed run as it was. */
+static void test_refine_refused(void)
+{
+    mesh_t sq = {0};
+    vpds_mesh_desc d;
+    vpds_mesh *s;
+    size_t n;
+    square_part(&sq, 0, 1, 1, 1, 0, 0, 1);
+    d = desc_for(&sq);
+    d.radius = 0.05;
+    if (!(s = run_mesh(&d))) return;
+    n = vpds_mesh_count(s);
+    CHECK(vpds_mesh_refine(s, 1e-7) == VPDS_ERR_OVERFLOW && strstr(vpds_mesh_last_error(s), "overflows"));
+    CHECK(vpds_mesh_count(s) == n && vpds_mesh_get_stats(s).maximal && vpds_mesh_get_stats(s).t == 1);
+    CHECK(vpds_mesh_run(s) == VPDS_OK && vpds_mesh_count(s) == n);
+    CHECK(vpds_mesh_refine(s, 0.5) == VPDS_OK && vpds_mesh_count(s) > 2 * n);
+    vpds_mesh_destroy(s);
+    mesh_free(&sq);
+}
+
 int main(void)
 {
     quick = getenv("VPDS_TEST_QUICK") != NULL;
@@ -971,5 +1093,8 @@ int main(void)
     test_determinism();
     test_bias();
     test_stream();
+    test_wide_extent();
+    test_lone_sliver();
+    test_refine_refused();
     CHECK_DONE();
 }
