@@ -1062,6 +1062,30 @@ static void test_lone_sliver(void)
     mesh_free(&m);
 }
 
+/* Triangles at the ends of the coordinate range are sampled, not refused: edges of 1e80 and of
+ * 1e-160 (their squared cross products would overflow or underflow unscaled). */
+static void test_extreme_sizes(void)
+{
+    double scales[2] = {1e80, 1e-160};
+    int k;
+    for (k = 0; k < 2; k++) {
+        double v[9] = {0, 0, 0, scales[k], 0, 0, 0, scales[k], 0};
+        uint32_t t[3] = {0, 1, 2};
+        vpds_mesh_desc d = vpds_default_mesh_desc();
+        vpds_mesh *s;
+        d.vertices = v;
+        d.n_vertices = 3;
+        d.triangles = t;
+        d.n_triangles = 1;
+        d.radius = k == 0 ? 0.2 * scales[k] : 1e-100;
+        if ((s = run_mesh(&d))) {
+            CHECK_MSG(vpds_mesh_count(s) >= 1 && (k == 1 || vpds_mesh_count(s) > 5), "edge %g: %zu samples",
+                      scales[k], vpds_mesh_count(s));
+            vpds_mesh_destroy(s);
+        }
+    }
+}
+
 /* A refinement refused for its size leaves the completed run as it was. */
 static void test_refine_refused(void)
 {
@@ -1096,5 +1120,6 @@ int main(void)
     test_wide_extent();
     test_lone_sliver();
     test_refine_refused();
+    test_extreme_sizes();
     CHECK_DONE();
 }
