@@ -340,7 +340,8 @@ const char *vpds_mesh_last_error(const vpds_mesh *s)
     return s->store.err;
 }
 
-static vpds_status mesh_work(vpds_mesh *s)
+/* The context of a call of the algorithms: the mesh, its subsystems and the problem. */
+static vpdsi_surface_ctx mesh_context(vpds_mesh *s)
 {
     vpdsi_surface_ctx c;
     c.mesh = &s->view;
@@ -353,6 +354,12 @@ static vpds_status mesh_work(vpds_mesh *s)
     c.budget = s->budget;
     c.progress = s->progress;
     c.progress_user = s->progress_user;
+    return c;
+}
+
+static vpds_status mesh_work(vpds_mesh *s)
+{
+    vpdsi_surface_ctx c = mesh_context(s);
     s->store.err[0] = 0;
     return vpdsi_surface_run(&s->surface, &c);
 }
@@ -400,7 +407,7 @@ vpds_status vpds_mesh_refine(vpds_mesh *s, double t)
 
 vpds_status vpds_mesh_next(vpds_mesh *s, double t_min, double *x_out, double *t_out)
 {
-    vpdsi_surface_stream_ctx c;
+    vpdsi_surface_ctx c;
     if (!live(s)) return VPDS_ERR_INVALID_ARGUMENT;
     if (!x_out || !t_out) {
         vpdsi_store_error(&s->store, "vpds_mesh_next: x_out and t_out must not be NULL");
@@ -415,13 +422,7 @@ vpds_status vpds_mesh_next(vpds_mesh *s, double t_min, double *x_out, double *t_
                           "starts from an empty mesh sampler in this version");
         return VPDS_ERR_STATE;
     }
-    c.mesh = &s->view;
-    c.st = &s->store;
-    c.marks = &s->marks;
-    c.rng = &s->rng;
-    c.stats = &s->stats;
-    c.rule = s->rule;
-    c.coverage = s->coverage;
+    c = mesh_context(s);
     s->store.err[0] = 0;
     return vpdsi_surface_next(&s->stream, &c, t_min, x_out, t_out);
 }

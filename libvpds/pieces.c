@@ -10,15 +10,10 @@
 static void lattice_point(const vpdsi_trimesh *mesh, uint64_t m, uint32_t k, double unit,
                           uint64_t i, uint64_t j, double *uv, double *x)
 {
-    const uint32_t *t = mesh->tri + 3 * (size_t)mesh->live[k];
-    const double *a = mesh->v + 3 * (size_t)t[0], *b = mesh->v + 3 * (size_t)t[1];
-    const double *c = mesh->v + 3 * (size_t)t[2];
     /* unit = 2^-level: the product is exact */
-    double u = (double)i / (double)m * unit, v = (double)j / (double)m * unit;
-    int q;
-    uv[0] = u;
-    uv[1] = v;
-    for (q = 0; q < 3; q++) x[q] = a[q] + u * (b[q] - a[q]) + v * (c[q] - a[q]);
+    uv[0] = (double)i / (double)m * unit;
+    uv[1] = (double)j / (double)m * unit;
+    vpdsi_trimesh_point(mesh, k, uv, x);
 }
 
 void vpdsi_piece_corners(const vpdsi_trimesh *mesh, uint64_t m, const vpdsi_piece *p,

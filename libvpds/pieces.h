@@ -4,6 +4,7 @@
  * surface (surface_stream.c); reads the store only for r at a point. */
 #ifndef VPDS_PIECES_H
 #define VPDS_PIECES_H
+#include "rng.h"
 #include "store.h"
 
 /* The mesh as the algorithm reads it (owned by the entry point): only the triangles of positive
@@ -45,6 +46,21 @@ vpds_status vpdsi_marks_reserve(vpdsi_surface_marks *mk, vpdsi_store *st, size_t
  * reserve). */
 void vpdsi_marks_append(vpdsi_surface_marks *mk, vpdsi_store *st, const vpdsi_trimesh *mesh,
                         uint32_t k, const double *uv, const double *x, double r, double t);
+
+/* What one call of a surface algorithm reads and writes (Algorithm 1, the stream: the stream
+ * has no budget or progress), and the problem's constants. */
+typedef struct vpdsi_surface_ctx {
+    const vpdsi_trimesh *mesh;
+    vpdsi_store *st;
+    vpdsi_surface_marks *marks;
+    vpdsi_rng *rng;
+    vpds_stats *stats;
+    vpds_rule rule;           /* resolved */
+    double coverage;          /* = inhibition */
+    uint64_t budget;
+    vpds_progress_fn progress;
+    void *progress_user;
+} vpdsi_surface_ctx;
 
 /* Corners of a piece (of a triangle cut into m x m seeds): parameters uv and positions x. */
 void vpdsi_piece_corners(const vpdsi_trimesh *mesh, uint64_t m, const vpdsi_piece *p,

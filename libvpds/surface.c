@@ -289,9 +289,6 @@ static void draw_piece_dart(const vpdsi_surface *s, const vpdsi_surface_ctx *ctx
     const vpdsi_trimesh *mesh = ctx->mesh;
     vpdsi_piece p;
     double a, b, scale;
-    const uint32_t *t;
-    const double *va, *vb, *vc;
-    int q;
     if (s->implicit) {
         memset(&p, 0, sizeof p);
         p.tri = (uint32_t)search_running_sums(s->tri_cum, mesh->n_live,
@@ -315,9 +312,7 @@ static void draw_piece_dart(const vpdsi_surface *s, const vpdsi_surface_ctx *ctx
     /* i * scale + a * scale keeps the low bits of a, which i + a would round away deep down */
     uv[0] = s->implicit ? a : (double)p.i * scale + a * scale;
     uv[1] = s->implicit ? b : (double)p.j * scale + b * scale;
-    t = mesh->tri + 3 * (size_t)mesh->live[p.tri];
-    va = mesh->v + 3 * (size_t)t[0], vb = mesh->v + 3 * (size_t)t[1], vc = mesh->v + 3 * (size_t)t[2];
-    for (q = 0; q < 3; q++) x[q] = va[q] + uv[0] * (vb[q] - va[q]) + uv[1] * (vc[q] - va[q]);
+    vpdsi_trimesh_point(mesh, p.tri, uv, x);
 }
 
 static vpds_status build_piece_sums(vpdsi_surface *s, const vpdsi_surface_ctx *ctx)

@@ -41,20 +41,6 @@ typedef struct vpdsi_surface {
     int32_t *near; size_t n_near, cap_near;
 } vpdsi_surface;
 
-/* What one call may do, and the problem's constants. */
-typedef struct vpdsi_surface_ctx {
-    const vpdsi_trimesh *mesh;
-    vpdsi_store *st;
-    vpdsi_surface_marks *marks;
-    vpdsi_rng *rng;
-    vpds_stats *stats;
-    vpds_rule rule;           /* resolved */
-    double coverage;          /* = inhibition */
-    uint64_t budget;
-    vpds_progress_fn progress;
-    void *progress_user;
-} vpdsi_surface_ctx;
-
 void vpdsi_surface_init(vpdsi_surface *s);
 void vpdsi_surface_release(vpdsi_surface *s, vpdsi_mem *m);
 /* Start sampling at scale t (the store may hold samples of larger scales). */

@@ -61,7 +61,7 @@ static double piece_centre(const vpdsi_trimesh *mesh, const vpdsi_piece *p, doub
 
 /* An upper bound of g over the piece: for y in it |y - x_i| <= |c - x_i| + h and
  * f(r(x_i), r(y)) >= f(r(x_i), r_lo), f being non-decreasing (vpdsi_kd_min_ratio's slack form). */
-static vpds_status piece_upper_bound(const vpdsi_surface_stream_ctx *ctx, const vpdsi_piece *p, double *ub)
+static vpds_status piece_upper_bound(const vpdsi_surface_ctx *ctx, const vpdsi_piece *p, double *ub)
 {
     vpdsi_kd_samples v = vpdsi_store_view(ctx->st);
     double uv[3][2], x[3][3], cuv[2], c[3], r_lo, r_hi, h = piece_centre(ctx->mesh, p, uv, x, cuv, c);
@@ -74,7 +74,7 @@ static vpds_status piece_upper_bound(const vpdsi_surface_stream_ctx *ctx, const 
 
 /* The first sample, uniform by area over the surface (t = infinity), and every live triangle as
  * a piece of the heap with an unknown (infinite) bound. */
-static vpds_status first_surface_sample(vpdsi_surface_stream *ss, const vpdsi_surface_stream_ctx *ctx,
+static vpds_status first_surface_sample(vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ctx,
                                 double *x_out, double *t_out)
 {
     const vpdsi_trimesh *mesh = ctx->mesh;
@@ -124,7 +124,7 @@ static vpds_status first_surface_sample(vpdsi_surface_stream *ss, const vpdsi_su
 
 /* g at the piece's centroid (r there exact); a better point than *best replaces it. With a sizing
  * callback the bounds trust the declared L: it is checked against the nearest sample. */
-static vpds_status look_at_centre(const vpdsi_surface_stream_ctx *ctx, const vpdsi_piece *p,
+static vpds_status look_at_centre(const vpdsi_surface_ctx *ctx, const vpdsi_piece *p,
                                   vpdsi_surface_best *best)
 {
     vpdsi_kd_samples v = vpdsi_store_view(ctx->st);
@@ -153,7 +153,7 @@ static vpds_status look_at_centre(const vpdsi_surface_stream_ctx *ctx, const vpd
 
 /* Split the top piece (bound ub) into its four children, each with its own bound and its centre
  * looked at; nothing changes on failure. */
-static vpds_status split_top(vpdsi_surface_stream *ss, const vpdsi_surface_stream_ctx *ctx, double ub,
+static vpds_status split_top(vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ctx, double ub,
                              vpdsi_surface_best *best)
 {
     vpdsi_piece p = ss->heap[0].p, child[4];
@@ -186,12 +186,12 @@ static vpds_status split_top(vpdsi_surface_stream *ss, const vpdsi_surface_strea
     return VPDS_OK;
 }
 
-static int may_split(const vpdsi_surface_stream_ctx *ctx, const vpdsi_piece *p)
+static int may_split(const vpdsi_surface_ctx *ctx, const vpdsi_piece *p)
 {
     return p->level < STREAM_MAX_LEVEL && vpdsi_piece_edge(ctx->mesh, 1, p) >= 2 * ctx->mesh->min_edge;
 }
 
-vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_stream_ctx *ctx,
+vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ctx,
                                double t_min, double *x_out, double *t_out)
 {
     vpdsi_surface_best *best = &ss->best;

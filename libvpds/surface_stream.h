@@ -27,20 +27,9 @@ typedef struct vpdsi_surface_stream {
     size_t n_heap, cap_heap;
 } vpdsi_surface_stream;
 
-/* What a call reads and writes. */
-typedef struct vpdsi_surface_stream_ctx {
-    const vpdsi_trimesh *mesh;
-    vpdsi_store *st;          /* in kd-tree mode */
-    vpdsi_surface_marks *marks;
-    vpdsi_rng *rng;
-    vpds_stats *stats;
-    vpds_rule rule;           /* resolved */
-    double coverage;          /* = inhibition */
-} vpdsi_surface_stream_ctx;
-
 void vpdsi_surface_stream_release(vpdsi_surface_stream *ss, vpdsi_mem *m);
 /* The next sample into x_out (3 doubles), its scale into *t_out: VPDS_OK, or VPDS_STREAM_END when
  * its scale would be at or below t_min (nothing consumed), or an error (nothing consumed). */
-vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_stream_ctx *ctx,
+vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ctx,
                                double t_min, double *x_out, double *t_out);
 #endif
