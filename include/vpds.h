@@ -44,8 +44,10 @@ extern "C" {
  * want of precision (same guarantees; other points with two radii or a domain). 3: a stream
  * continued after a run splits its regions down to the run's scale before searching them
  * (versions 1-2 searched the whole box at once and could give up with VPDS_ERR_DOMAIN; other
- * points for vpds_next after vpds_run). */
-#define VPDS_ALGORITHM_VERSION 3
+ * points for vpds_next after vpds_run). 4: with two radii the coverage search keeps what it
+ * learns (cells shown covered, witness points) and a dart asks only about the cells near it;
+ * the points of version 3 except where the search's box budget or precision decided. */
+#define VPDS_ALGORITHM_VERSION 4
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 16
 /* Relative tolerance eps of the continuous stream (vpds_next): each t it reports is an upper

@@ -300,6 +300,7 @@ static vpds_status judge_dart(vpdsi_mps *m, const vpdsi_ctx *ctx, const double *
         /* no cell that may hold an uncovered point within reach: nothing new to cover */
         if (vpdsi_uncovered_nearest(&m->unc, y) > coverage_reach(m, ctx, ry) + m->unc.half)
             return VPDS_OK;
+        if (pb->algorithm >= 4) return vpdsi_uncovered_dart(&m->unc, ctx, m->run.t, y, ry, accept);
         return vpdsi_uncovered_in(&m->unc, ctx, m->run.t, y, y, ry, accept);
     }
     *accept = 1;
@@ -551,6 +552,14 @@ oom:
     return VPDS_ERR_OUT_OF_MEMORY;
 }
 
+static int point_in_box(int d, const double *p, const double *lo, const double *hi)
+{
+    int k;
+    for (k = 0; k < d; k++)
+        if (p[k] < lo[k] || p[k] > hi[k]) return 0;
+    return 1;
+}
+
 /* Two radii: which kept children of the block may hold an uncovered point: not inside one
  * coverage disk (the gather, at the larger coverage reach, found every candidate; whole_c: the
  * cell is inside one), and not shown covered by a search inside them. */
@@ -558,25 +567,39 @@ static vpds_status flag_uncovered(vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned l
                                   const uint64_t *c, int split, unsigned block, int whole_c,
                                   double r_lo, const uint64_t *covered, uint8_t *flag)
 {
-    int d = ctx->pb->dim;
+    int d = ctx->pb->dim, learn = ctx->pb->algorithm >= 4, parent = VPDSI_CELL_UNKNOWN;
     unsigned children = block_children(d, split), b;
     uint64_t cov_c[4] = {0, 0, 0, 0}, cc[VPDS_MAX_DIM];
-    double scale_c = m->run.t * ctx->pb->coverage;
+    double scale_c = m->run.t * ctx->pb->coverage, wbuf[VPDS_MAX_DIM + 1];
+    const double *pw = NULL;
     vpds_status e;
-    if (whole_c)
+    /* version 4: a parent shown covered has covered children; its witness flags one of them */
+    if (learn && (e = vpdsi_uncovered_parent(&m->unc, ctx, m->run.t, m->run.pos, &parent, &pw)) != VPDS_OK)
+        return e;
+    if (whole_c || parent == VPDSI_CELL_COVERED)
         cov_c[0] = cov_c[1] = cov_c[2] = cov_c[3] = ~UINT64_C(0);
     else if (split)
         children_covered(m, ctx, level, c, r_lo, scale_c, block, cov_c);
     for (b = 0; b < children; b++) {
         double clo[VPDS_MAX_DIM], chi[VPDS_MAX_DIM];
         int found = 0;
+        vpdsi_search_out out;
         flag[b] = 0;
         if (bit_set(covered, b) || bit_set(cov_c, b)) continue;
         child_coords(d, c, child_number(block, b), split, cc);
         vpdsi_lattice_box(&m->run.geom, split ? level + 1 : level, cc, clo, chi);
-        if ((e = vpdsi_uncovered_in(&m->unc, ctx, m->run.t, clo, chi, 0.0, &found)) != VPDS_OK)
+        if (pw && point_in_box(d, pw, clo, chi)) { /* still uncovered, so this child is flagged */
+            flag[b] = 1;
+            vpdsi_uncovered_record(&m->unc, d, pw);
+            pw = NULL;
+            continue;
+        }
+        out.budget = VPDSI_UNCOVERED_BUDGET;
+        out.witness = wbuf;
+        if ((e = vpdsi_uncovered_in_box(&m->unc, ctx, m->run.t, clo, chi, 0.0, NULL, &out, &found)) != VPDS_OK)
             return e;
         flag[b] = (uint8_t)found;
+        if (found && learn) vpdsi_uncovered_record(&m->unc, d, out.found_point ? wbuf : NULL);
     }
     return VPDS_OK;
 }
@@ -628,7 +651,7 @@ static vpds_status sweep_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t
     double h = sqrt(vpdsi_lattice_box(&run->geom, level, c, lo, hi));
     double r_lo = need_r ? rc - L * h / 2 : st->sizing.radius;
     double r_hi = need_r ? rc + L * h / 2 : st->sizing.radius;
-    size_t kept = run->next.count;
+    size_t kept = run->next.count, records = m->unc.n_nwit;
     vpds_status e;
     if (ctx->dom->fn) {
         for (k = 0; k < d; k++) centre[k] = 0.5 * (lo[k] + hi[k]);
@@ -641,6 +664,7 @@ static vpds_status sweep_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t
     for (block = 0; block < blocks; block++) {
         if ((e = sweep_block(m, ctx, c, split, block, r_lo, centre, phi, h, whole_c)) != VPDS_OK) {
             run->next.count = kept;
+            m->unc.n_nwit = records;
             return e;
         }
     }
@@ -663,7 +687,9 @@ static vpds_status sweep_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, int
     if (vpdsi_mul_size(n, children, &need) ||
         vpdsi_cells_reserve(&run->next, ctx->mem, run->next.count + need) ||
         (pb->two_radii && vpdsi_mem_reserve(ctx->mem, (void **)&m->unc.flag, &m->unc.cap_flag,
-                                            run->next.count + need, 1))) {
+                                            run->next.count + need, 1)) ||
+        (pb->two_radii && pb->algorithm >= 4 &&
+         vpdsi_uncovered_reserve_records(&m->unc, ctx->mem, pb->dim, need))) {
         vpdsi_store_error(ctx->st, "out of memory for the active cells of level %u", run->next.level);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
@@ -692,7 +718,9 @@ static vpds_status vfilter_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
     double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], centre[VPDS_MAX_DIM];
     size_t j;
     vpds_status e;
-    if (!m->unc.ready && (e = vpdsi_uncovered_index(&m->unc, st, &m->run.next, &m->run.geom)) != VPDS_OK) return e;
+    if (!m->unc.ready && (e = vpdsi_uncovered_index(&m->unc, st, &m->run.next, &m->run.geom,
+                                                       ctx->pb->algorithm >= 4)) != VPDS_OK)
+        return e;
     if (varying) {
         if ((e = reserve_buffers(m, ctx, n)) != VPDS_OK) return e;
         for (j = 0; j < n; j++) {
@@ -710,7 +738,7 @@ static vpds_status vfilter_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
         for (k = 0; k < d; k++) centre[k] = 0.5 * (lo[k] + hi[k]);
         if (vpdsi_uncovered_nearest(&m->unc, centre) <= coverage_reach(m, ctx, r_hi) + h + m->unc.half) {
             vpdsi_cells_move(&run->next, i, (size_t)run->wpos);
-            m->unc.flag[run->wpos] = m->unc.flag[i];
+            vpdsi_uncovered_move(&m->unc, i, (size_t)run->wpos);
             run->wpos++;
         }
         run->vpos++;
@@ -756,6 +784,7 @@ static void begin_sweep(vpdsi_mps *m, const vpdsi_ctx *ctx, int split)
 {
     vpdsi_cells_layout(&m->run.next, ctx->pb->dim, m->run.geom.n0, cur_level(m) + (split ? 1u : 0u));
     m->run.pos = 0;
+    m->unc.n_nwit = 0; /* the witness records of this sweep's flagged cells */
     m->strip.key = m->base.key = 0; /* new samples, and with a new scale new base cells */
 }
 

@@ -9,7 +9,6 @@
 #include <math.h>
 #include <string.h>
 
-#define UNCOVERED_BUDGET 20000 /* boxes per question before answering "yes" conservatively */
 #define UNCOVERED_DEPTH 40
 #define LIST_CAP 128 /* candidates a box keeps for its sub-boxes; more and they read the kd-trees */
 #define LIST_SLOTS ((size_t)(UNCOVERED_DEPTH + 1) * 2 * LIST_CAP)
@@ -36,6 +35,10 @@ typedef struct {
     double r_anchor, scale, L, reach, slack;
     int point, lists; /* lists: the slots are allocated */
     int exact_region; /* version 2: a box beyond a point anchor's region is dropped */
+    int in_cell;      /* the first box is one indexed cell: the centres cannot prune */
+    size_t budget;    /* boxes this search may examine */
+    double *witness;  /* where the uncovered point found goes (dim coordinates, then r there) */
+    int found_point;  /* *found came from such a point, not from the budget or the precision */
     vpdsi_kd_samples view, uview;
     bb_lists lv[UNCOVERED_DEPTH + 1];
     /* the box being examined: kept here, not in the helpers' frames, which then cost nothing
@@ -44,85 +47,6 @@ typedef struct {
     size_t count;
     int32_t w;
 } bb_search;
-
-void vpdsi_uncovered_init(vpdsi_uncovered *u, int dim, const double *period)
-{
-    memset(u, 0, sizeof *u);
-    vpdsi_kd_init(&u->tree, dim);
-    vpdsi_kd_set_period(&u->tree, period);
-}
-
-void vpdsi_uncovered_release(vpdsi_uncovered *u, vpdsi_mem *m)
-{
-    vpdsi_mem_free(m, u->flag, u->cap_flag);
-    vpdsi_kd_release(&u->tree, m);
-    vpdsi_mem_free(m, u->x, u->cap_x * sizeof(double));
-    vpdsi_mem_free(m, u->r, u->cap_r * sizeof(double));
-    vpdsi_mem_free(m, u->f, u->cap_f);
-    vpdsi_mem_free(m, u->lists, u->cap_lists * sizeof(int32_t));
-    vpdsi_mem_free(m, u->stack, u->cap_stack * sizeof(double));
-    u->flag = u->f = NULL;
-    u->x = u->r = u->stack = NULL;
-    u->lists = NULL;
-    u->cap_flag = u->cap_x = u->cap_r = u->cap_f = u->cap_lists = u->cap_stack = 0;
-    u->ready = 0;
-}
-
-static vpdsi_kd_samples centres_view(const vpdsi_uncovered *u)
-{
-    vpdsi_kd_samples v;
-    v.x = u->x;
-    v.r = u->r;
-    v.flags = u->f;
-    return v;
-}
-
-vpds_status vpdsi_uncovered_index(vpdsi_uncovered *u, vpdsi_store *st, const vpdsi_cells *next,
-                                  const vpdsi_lattice *g)
-{
-    int d = g->dim, k;
-    size_t i, m = 0, nx;
-    uint64_t c[VPDS_MAX_DIM];
-    vpdsi_kd_samples v;
-    u->ready = 0;
-    for (i = 0; i < next->count; i++) m += u->flag[i] != 0;
-    if (vpdsi_mul_size(m + 1, (size_t)d, &nx) ||
-        vpdsi_mem_reserve(st->mem, (void **)&u->x, &u->cap_x, nx, sizeof(double)) ||
-        vpdsi_mem_reserve(st->mem, (void **)&u->r, &u->cap_r, m + 1, sizeof(double)) ||
-        vpdsi_mem_reserve(st->mem, (void **)&u->f, &u->cap_f, m + 1, 1)) {
-        vpdsi_store_error(st, "out of memory indexing %zu uncovered cells", m);
-        return VPDS_ERR_OUT_OF_MEMORY;
-    }
-    vpdsi_kd_clear(&u->tree);
-    if (vpdsi_kd_reserve(&u->tree, st->mem, m + 1, m + 1)) {
-        vpdsi_store_error(st, "out of memory indexing %zu uncovered cells", m);
-        return VPDS_ERR_OUT_OF_MEMORY;
-    }
-    u->half = 0;
-    v = centres_view(u);
-    for (i = 0, m = 0; i < next->count; i++) {
-        double half2, lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
-        if (!u->flag[i]) continue;
-        vpdsi_cells_get(next, i, d, c);
-        half2 = 0.25 * vpdsi_lattice_box(g, next->level, c, lo, hi);
-        for (k = 0; k < d; k++) u->x[m * (size_t)d + (size_t)k] = 0.5 * (lo[k] + hi[k]);
-        if (sqrt(half2) > u->half) u->half = sqrt(half2);
-        u->r[m] = 1.0;
-        u->f[m] = 0;
-        vpdsi_kd_insert(&u->tree, &v, (int32_t)m);
-        m++;
-    }
-    u->ready = 1;
-    return VPDS_OK;
-}
-
-double vpdsi_uncovered_nearest(const vpdsi_uncovered *u, const double *p)
-{
-    vpdsi_kd_samples v = centres_view(u);
-    int32_t arg;
-    if (!u->ready) return 0.0;
-    return vpdsi_kd_min_ratio(&u->tree, &v, p, 0.0, 1.0, (int)VPDS_RULE_PRIOR, &arg);
-}
 
 static size_t slot(int depth, int samples)
 {
@@ -237,7 +161,8 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
     }
     if (gap2 > q->reach * q->reach) return VPDS_OK; /* misses the region */
     /* no cell that may hold an uncovered point meets the box */
-    if (q->u->ready && !near_uncovered(q, depth, c2, 0.5 * sqrt(diag2) + q->u->half)) return VPDS_OK;
+    if (q->u->ready && !q->in_cell && !near_uncovered(q, depth, c2, 0.5 * sqrt(diag2) + q->u->half))
+        return VPDS_OK;
     /* the box lies outside the domain: nothing there needs covering */
     if (q->dom->fn) {
         if ((st = vpdsi_domain_at(q->dom, q->st, c2, &q->phi)) != VPDS_OK) return st;
@@ -279,6 +204,11 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
         if (q->dom->fn && (st = vpdsi_domain_at(q->dom, q->st, p, &q->phi)) != VPDS_OK) return st;
         if (q->phi <= 0) {
             *verdict = 1;
+            q->found_point = 1;
+            if (q->witness) {
+                memcpy(q->witness, p, (size_t)d * sizeof(double));
+                q->witness[d] = q->rp;
+            }
             return VPDS_OK;
         }
     }
@@ -344,7 +274,7 @@ static vpds_status search(bb_search *q, int *found)
             memcpy(lo, bx, (size_t)d * sizeof(double));
             memcpy(hi, bx + d, (size_t)d * sizeof(double));
             q->u->boxes++;
-            if (++boxes > UNCOVERED_BUDGET) {
+            if (++boxes > q->budget) {
                 *found = 1;
                 return VPDS_OK;
             }
@@ -374,30 +304,33 @@ static vpds_status search(bb_search *q, int *found)
     return VPDS_OK;
 }
 
-vpds_status vpdsi_uncovered_in(vpdsi_uncovered *u, const vpdsi_ctx *ctx, double t,
-                               const double *alo, const double *ahi, double r_anchor, int *found)
+/* The search's state for the anchor box [alo, ahi]; *found = 1 when the region cannot be
+ * searched (scale * L >= 1: it has no bound), VPDS_OK with q ready otherwise. */
+static vpds_status prepare(bb_search *q, vpdsi_uncovered *u, const vpdsi_ctx *ctx, double t,
+                           const double *alo, const double *ahi, double r_anchor, int *found)
 {
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_store *st = ctx->st;
     int d = pb->dim;
     size_t stride = 2 * (size_t)d + 2, need;
-    bb_search q;
     vpds_status e;
     *found = 0;
-    q.u = u;
-    q.pb = pb;
-    q.st = st;
-    q.dom = ctx->dom;
-    q.alo = alo;
-    q.ahi = ahi;
-    q.r_anchor = r_anchor;
-    q.scale = t * pb->coverage;
-    q.L = st->sizing.lipschitz;
-    q.point = memcmp(alo, ahi, (size_t)d * sizeof(double)) == 0;
-    q.exact_region = pb->algorithm >= 2;
+    memset(q, 0, sizeof *q);
+    q->u = u;
+    q->pb = pb;
+    q->st = st;
+    q->dom = ctx->dom;
+    q->alo = alo;
+    q->ahi = ahi;
+    q->r_anchor = r_anchor;
+    q->scale = t * pb->coverage;
+    q->L = st->sizing.lipschitz;
+    q->point = memcmp(alo, ahi, (size_t)d * sizeof(double)) == 0;
+    q->exact_region = pb->algorithm >= 2;
+    q->budget = VPDSI_UNCOVERED_BUDGET;
     /* largest reach of the region: r(u) <= r_anchor + L |u - a| and |u - a| <= scale r(u) */
-    q.reach = vpdsi_rule_reach(pb->rule, q.scale, q.L, r_anchor);
-    if (!(q.scale * q.L < 1)) {
+    q->reach = vpdsi_rule_reach(pb->rule, q->scale, q->L, r_anchor);
+    if (!(q->scale * q->L < 1)) {
         *found = 1;
         return VPDS_OK;
     }
@@ -408,11 +341,38 @@ vpds_status vpdsi_uncovered_in(vpdsi_uncovered *u, const vpdsi_ctx *ctx, double 
     }
     if ((e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
     /* without room for the lists every test reads the kd-trees, as fast as before them */
-    q.lists = vpdsi_mem_reserve(st->mem, (void **)&u->lists, &u->cap_lists, LIST_SLOTS,
-                                sizeof(int32_t)) == 0;
+    q->lists = vpdsi_mem_reserve(st->mem, (void **)&u->lists, &u->cap_lists, LIST_SLOTS,
+                                 sizeof(int32_t)) == 0;
+    q->view = vpdsi_store_view(st);
+    q->uview = vpdsi_uncovered_view(u);
+    return VPDS_OK;
+}
+
+vpds_status vpdsi_uncovered_in(vpdsi_uncovered *u, const vpdsi_ctx *ctx, double t,
+                               const double *alo, const double *ahi, double r_anchor, int *found)
+{
+    return vpdsi_uncovered_in_box(u, ctx, t, alo, ahi, r_anchor, NULL, NULL, found);
+}
+
+vpds_status vpdsi_uncovered_in_box(vpdsi_uncovered *u, const vpdsi_ctx *ctx, double t,
+                                   const double *alo, const double *ahi, double r_anchor,
+                                   const double *cell, vpdsi_search_out *out, int *found)
+{
+    int d = ctx->pb->dim;
+    bb_search q;
+    vpds_status e = prepare(&q, u, ctx, t, alo, ahi, r_anchor, found);
+    if (e != VPDS_OK || *found) return e;
     first_box(&q, u->stack);
-    q.slack = list_slack(pb, u->stack, u->stack + d);
-    q.view = vpdsi_store_view(st);
-    q.uview = centres_view(u);
-    return search(&q, found);
+    if (cell) { /* the region's part in that cell: the anchor's centre stays the one first_box set */
+        memcpy(u->stack, cell, 2 * (size_t)d * sizeof(double));
+        q.in_cell = 1;
+    }
+    if (out) {
+        if (out->budget < q.budget) q.budget = out->budget;
+        q.witness = out->witness;
+    }
+    q.slack = list_slack(ctx->pb, u->stack, u->stack + d);
+    e = search(&q, found);
+    if (out) out->found_point = q.found_point;
+    return e;
 }

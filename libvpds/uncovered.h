@@ -21,7 +21,41 @@ typedef struct vpdsi_uncovered {
     int32_t *lists; size_t n_lists, cap_lists; /* candidate lists of a search, per depth */
     double *stack; size_t cap_stack;           /* boxes still to examine */
     uint64_t boxes; /* boxes examined so far: work units of the budget, as darts and cells */
+    /* Version 4: what the questions learn about the indexed cells, so that later ones skip
+     * it. Coverage at one scale only grows, so a cell shown covered stays covered, and a point
+     * seen uncovered stays a witness until one conflict query says otherwise. */
+    double *cbox; size_t cap_cbox;     /* per indexed cell: its box, dim lows then dim highs */
+    double *wit; size_t cap_wit;       /* per indexed cell: dim coordinates and r of a witness */
+    uint8_t *state; size_t cap_state;  /* per indexed cell: VPDSI_CELL_* */
+    int32_t *centre_of; size_t cap_centre_of; /* per cell of the level: its index, -1: none */
+    /* the sweep's witnesses, one record per flagged cell of the next level, in order */
+    double *nwit; size_t n_nwit, cap_nwit;
+    size_t n_centre_of;
+    int32_t *cand; size_t cap_cand;    /* the indexed cells near a dart */
+    int learn;                         /* the index keeps what is learnt (version 4) */
 } vpdsi_uncovered;
+
+#define VPDSI_UNCOVERED_BUDGET 20000 /* boxes per question before answering "yes" conservatively */
+
+#define VPDSI_CELL_UNKNOWN 0 /* may hold an uncovered point */
+#define VPDSI_CELL_WITNESS 1 /* held one (wit) when last looked at */
+#define VPDSI_CELL_COVERED 2 /* holds none: left out of every question (its centre's r is 0) */
+
+/* What a search from a given first box reports beyond *found. */
+typedef struct vpdsi_search_out {
+    size_t budget;    /* in: boxes it may examine (past them it answers "uncovered") */
+    double *witness;  /* in: room for dim + 1 doubles, the point found and r there (or NULL) */
+    int found_point;  /* out: *found came from such a point */
+} vpdsi_search_out;
+
+static inline vpdsi_kd_samples vpdsi_uncovered_view(const vpdsi_uncovered *u)
+{
+    vpdsi_kd_samples v;
+    v.x = u->x;
+    v.r = u->r;
+    v.flags = u->f;
+    return v;
+}
 
 void vpdsi_uncovered_init(vpdsi_uncovered *u, int dim, const double *period);
 void vpdsi_uncovered_release(vpdsi_uncovered *u, vpdsi_mem *m);
@@ -34,10 +68,31 @@ void vpdsi_uncovered_release(vpdsi_uncovered *u, vpdsi_mem *m);
  * its box budget or precision (a dart then becomes a sample that may cover nothing new). */
 vpds_status vpdsi_uncovered_in(vpdsi_uncovered *u, const vpdsi_ctx *ctx, double t,
                                const double *alo, const double *ahi, double r_anchor, int *found);
+/* vpdsi_uncovered_in from the first box `cell` (dim lows then highs, in coordinates around the
+ * anchor: one indexed cell's image; NULL: the region's bounding box), with `out` (or NULL). */
+vpds_status vpdsi_uncovered_in_box(vpdsi_uncovered *u, const vpdsi_ctx *ctx, double t,
+                                   const double *alo, const double *ahi, double r_anchor,
+                                   const double *cell, vpdsi_search_out *out, int *found);
+
+/* Version 4's dart question (the dart y, r(y) = ry): vpdsi_uncovered_in(y, y) answered cell by
+ * cell over the indexed cells near y, from their witnesses first; each cell the region holds
+ * whole and shows covered leaves every later question. */
+vpds_status vpdsi_uncovered_dart(vpdsi_uncovered *u, const vpdsi_ctx *ctx, double t,
+                                 const double *y, double ry, int *accept);
+/* The state of active cell `pos` for its children's flags: *state VPDSI_CELL_COVERED (they
+ * need no search), VPDSI_CELL_WITNESS with *witness a point still uncovered, else UNKNOWN. */
+vpds_status vpdsi_uncovered_parent(vpdsi_uncovered *u, const vpdsi_ctx *ctx, double t, size_t pos,
+                                   int *state, const double **witness);
+/* Room for `more` sweep records; one record (witness NULL: none) per flagged cell, in order. */
+int vpdsi_uncovered_reserve_records(vpdsi_uncovered *u, vpdsi_mem *m, int dim, size_t more);
+void vpdsi_uncovered_record(vpdsi_uncovered *u, int dim, const double *witness);
+/* The filter moved cell `from` of the next level to `to`. */
+void vpdsi_uncovered_move(vpdsi_uncovered *u, size_t from, size_t to);
+
 /* Index the centres of the cells `next` (geometry g) flagged in u->flag: every uncovered point
- * lies in one of them, now and after any later sample. */
+ * lies in one of them, now and after any later sample; with `learn`, keep what is learnt. */
 vpds_status vpdsi_uncovered_index(vpdsi_uncovered *u, vpdsi_store *st, const vpdsi_cells *next,
-                                  const vpdsi_lattice *g);
+                                  const vpdsi_lattice *g, int learn);
 /* Distance from p to the nearest indexed centre (+INFINITY: none; 0 when no index is ready,
  * which answers "maybe" to every question). */
 double vpdsi_uncovered_nearest(const vpdsi_uncovered *u, const double *p);

@@ -85,6 +85,12 @@ static void ca_free(void *p, size_t size, void *user)
 }
 
 /* VPDS_TEST_QUICK (set under valgrind): the ramp from x = 0.01, a tenth of the samples */
+static double ramp3_counted(const double *x, void *u)
+{
+    ++*(size_t *)u;
+    return 0.08 + 0.2 * fabs(x[0]);
+}
+
 static const double quick_lo[2] = {0.01, 0.0};
 static int quick;
 
@@ -112,8 +118,8 @@ static double *run_copy(const vpds_desc *d, size_t *n)
         return NULL;
     }
     *n = vpds_count(s);
-    copy = (double *)malloc(*n * 2 * sizeof(double));
-    memcpy(copy, vpds_points(s), *n * 2 * sizeof(double));
+    copy = (double *)malloc(*n * (size_t)vpds_dim(s) * sizeof(double) + 1);
+    memcpy(copy, vpds_points(s), *n * (size_t)vpds_dim(s) * sizeof(double));
     vpds_destroy(s);
     return copy;
 }
@@ -337,11 +343,46 @@ int main(void)
         vpds_destroy(s);
     }
 
+    /* Two radii, version 4: the coverage search's index keeps what it learns (cells shown
+     * covered, witnesses), so a 3D run with periodic axes gives the points of version 3 with
+     * far fewer sizing evaluations (each examined box reads r once) */
+    {
+        static const double lo3[3] = {0, 0, 0}, hi3[3] = {1, 1, 1};
+        static const int periodic3[3] = {0, 1, 1};
+        size_t calls[2] = {0, 0}, n[2] = {0, 0};
+        double *pts[2];
+        int v;
+        for (v = 0; v < 2; v++) {
+            vpds_desc d3 = vpds_default_desc();
+            d3.dim = 3;
+            d3.lo = lo3;
+            d3.hi = hi3;
+            d3.rule = VPDS_RULE_BIGGER;
+            d3.seed = 7;
+            d3.sizing = ramp3_counted;
+            d3.sizing_user = &calls[v];
+            d3.lipschitz = 0.2;
+            d3.inhibition = 0.5;
+            d3.periodic = periodic3;
+            d3.algorithm_version = v ? 4 : 3;
+            pts[v] = run_copy(&d3, &n[v]);
+        }
+        CHECK(pts[0] != NULL && pts[1] != NULL);
+        CHECK_MSG(pts[0] && pts[1] && n[0] > 300 && n[0] == n[1] &&
+                      memcmp(pts[0], pts[1], n[0] * 3 * sizeof(double)) == 0,
+                  "version 4 gave other points: %zu against %zu", n[1], n[0]);
+        CHECK_MSG(calls[1] < 0.85 * (double)calls[0], "version 4 read r %zu times, version 3 %zu",
+                  calls[1], calls[0]);
+        free(pts[0]);
+        free(pts[1]);
+    }
+
     /* allocator: count the allocations of a run, then fail each one in turn (a variable-radius
-     * run on the kd-tree, and a uniform one on the background grid) */
+     * run on the kd-tree, a uniform one on the background grid, and two radii with a variable
+     * radius: the coverage search and what its index learns) */
     {
         int which;
-        for (which = 0; which < 2; which++) {
+        for (which = 0; which < 3; which++) {
             counting_alloc ca;
             vpds_sampler *s = NULL;
             size_t total, k, reached = 0, n_base, sites;
@@ -352,6 +393,12 @@ int main(void)
                 d = vpds_default_desc();
                 d.radius = 0.02;
                 d.seed = 3;
+            } else if (which == 2) {
+                static const double lo2[2] = {0.05, 0.0};
+                d.lo = lo2; /* r >= 0.016: a few hundred samples, each run short */
+                d.rule = VPDS_RULE_SMALLER;
+                d.inhibition = 0.5;
+                d.seed = 5;
             }
             base = run_copy(&d, &n_base);
             d.allocator.alloc = ca_alloc;
@@ -388,11 +435,13 @@ int main(void)
                 CHECK_MSG(ca.live_bytes == 0, "leak after failing allocation %zu", k);
             }
             /* the grid's own allocations (stencil, cells, candidates) may fail without an error:
-             * the run falls back to the kd-tree, with the same points as checked above */
-            CHECK(reached <= total && total - reached <= (which ? 5u : 0u));
+             * the run falls back to the kd-tree, with the same points as checked above; so may
+             * the coverage search's candidate lists (its tests then read the kd-trees) */
+            CHECK(reached <= total && total - reached <= (which == 1 ? 5u : which == 2 ? 1u : 0u));
             printf("allocation failure (%s): %zu allocations from %zu call sites (0: not counted in"
                    " this build), each failed once, %zu seen as VPDS_ERR_OUT_OF_MEMORY\n",
-                   which ? "uniform, grid" : "ramp, kd-tree", total, sites, reached);
+                   which == 2 ? "ramp, two radii" : which ? "uniform, grid" : "ramp, kd-tree", total,
+                   sites, reached);
             free(base);
         }
     }

@@ -217,8 +217,9 @@ def test_callable_sampled_onto_a_grid_is_an_approximation_with_its_own_l():
 def test_algorithm_version_pins_the_points():
     """Version 1 keeps the points made before version 2 changed the two-radii coverage search;
     one radius is the same under both; version 3 changed only the stream (a run's points are
-    those of version 2); a version the library does not have is refused."""
-    assert vpds.ALGORITHM_VERSION == 3
+    those of version 2); version 4 made the search learn, with the points of version 3; a
+    version the library does not have is refused."""
+    assert vpds.ALGORITHM_VERSION == 4
 
     def fill(version, inhibition):
         engine = vpds.PoissonDisk(2, sizing=lambda x: 0.04 + 0.04 * x[:, 0], lipschitz=0.04,
@@ -227,10 +228,11 @@ def test_algorithm_version_pins_the_points():
         return engine.fill_space()
 
     current, v1, v2, v3 = fill(None, 0.6), fill(1, 0.6), fill(2, 0.6), fill(3, 0.6)
+    assert np.array_equal(current, fill(4, 0.6))
     assert np.array_equal(current, v3)
     assert np.array_equal(v2, v3)
     assert not np.array_equal(v1, v2)
     assert np.array_equal(fill(1, 1.0), fill(2, 1.0))
-    for bad in (4, -1, 1.5, True):
-        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.3"):
+    for bad in (5, -1, 1.5, True):
+        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.4"):
             vpds.PoissonDisk(2, algorithm_version=bad)
