@@ -32,6 +32,7 @@ ffibuilder.cdef("static const double VPDS_STREAM_TOLERANCE;")
 ffibuilder.cdef("static const double VPDS_STREAM_DOMAIN_TOLERANCE;")
 ffibuilder.cdef("#define VPDS_ALGORITHM_VERSION ...")
 ffibuilder.cdef("#define VPDS_MAX_DIM ...")
+ffibuilder.cdef("#define VPDS_TILING_MAX_DIM ...")
 # the batched sizing callback that runs Python code (see vpds._core.vpds_py_sizing_batch)
 ffibuilder.cdef('''extern "Python" int vpds_py_sizing_batch(const double *x, size_t n, double *r_out,
                                                       void *user);''')

@@ -16,6 +16,7 @@ from ._scipy_compat import _optimization_name, _scipy_optimizers, _seed_from, _v
 from .sizing_grid import SizingGrid
 from ._typing import RngLike, SizingFunction
 from .estimate import Estimate
+from ._tiled import TilesLike, check_workers, refuse_with_tiles, tiled_fill
 
 __all__ = ["PoissonDisk", "SizingGrid", "VpdsError", "VpdsSizingError", "VpdsDomainError",
            "Progressive", "RULES", "ALGORITHM_VERSION", "MAX_DIM"]
@@ -122,6 +123,20 @@ class PoissonDisk:
       memory_limit: most bytes the C sampler may hold (None: no limit); a run whose estimate
                   (`estimate()`) exceeds it is refused before it starts, and an allocation past
                   it fails cleanly: MemoryError, the sampler as it was.
+      workers, tiles: several cores for fill_space() (scipy's spelling: an int >= 1, -1 for
+                  every core). workers=1 without tiles (the default) is the serial process
+                  above. Otherwise the box is sampled as a grid of tiles (vpds.tiling: every
+                  guarantee across the seams, the points in the order (phase, tile, insertion))
+                  on that many threads: `tiles` = "auto" (the default then: sides of about 64
+                  margins in 2D, 12 in 3D, 6 past 3D, the margin being coverage * r_max; from
+                  the box and radii only), an int or d ints. The tiling decides the points,
+                  never the worker count: the same bytes for every `workers`, other points than
+                  the serial process's. A tiled engine fills the whole box at once: random(n)
+                  of finite n, refine, stream, progressive and add_points need the serial
+                  process and are refused; so are a domain, fixed points, a memory limit and a
+                  pinned algorithm_version, which the tiling does not take. A Python sizing
+                  callable runs on the calling thread only (the GIL): the tiles then run one
+                  after another; a grid (or `sizing_grid_shape`) runs on every worker.
     Results are numpy arrays of shape (n, d) (copies: they outlive the sampler).
     """
 
@@ -139,7 +154,8 @@ class PoissonDisk:
                  sizing_range: Optional[Sequence[float]] = None,
                  sizing_grid_shape: Optional[Sequence[int]] = None, domain: Optional[DomainLike] = None,
                  domain_threshold: float = 0.5, algorithm_version: Optional[int] = None,
-                 memory_limit: Optional[int] = None) -> None:
+                 memory_limit: Optional[int] = None, workers: int = 1,
+                 tiles: TilesLike = None) -> None:
         if seed is not None and rng is not None:
             raise TypeError("PoissonDisk() got multiple values for argument now known as `rng`. "
                             "Specify one of `rng` or `seed`.")
@@ -256,6 +272,11 @@ class PoissonDisk:
             st = lib.vpds_validate(stand_in, msg, 1024)
             if st != lib.VPDS_OK:
                 _raise(st, ffi.string(msg).decode())
+        self._periodic = None if periodic is None else tuple(bool(p) for p in periodic)
+        self.workers = check_workers(workers)
+        self.tiles: TilesLike = "auto" if tiles is None and self.workers != 1 else tiles
+        self._check_tiled(domain, fixed_points, memory_limit, algorithm_version)
+        self._tiled: Optional[tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], int, int]] = None
         self._fixed = None
         if fixed_points is not None:
             fx = np.ascontiguousarray(fixed_points, dtype=np.float64).reshape(-1, self.d)
@@ -265,9 +286,32 @@ class PoissonDisk:
             self._fixed = (fx, fr)
         self.reset()
 
+    def _check_tiled(self, domain: Any, fixed_points: Any, memory_limit: Any,
+                     algorithm_version: Any) -> None:
+        """Refuse up front what a tiled engine (workers != 1 or tiles) cannot take."""
+        if self.tiles is None or self.d == 0:
+            return
+        given = [name for name, v in (("domain", domain), ("fixed_points", fixed_points),
+                                      ("memory_limit", memory_limit),
+                                      ("algorithm_version", algorithm_version))
+                 if v is not None and not (name in ("memory_limit", "algorithm_version") and v == 0)]
+        if given:
+            raise ValueError(f"workers = {self.workers}, tiles = {self.tiles!r}: the tiled process "
+                             f"does not take {', '.join(given)} (workers=1 without tiles does)")
+        if self.d > int(lib.VPDS_TILING_MAX_DIM):
+            raise ValueError(f"workers = {self.workers}, tiles = {self.tiles!r}: tilings have at "
+                             f"most {int(lib.VPDS_TILING_MAX_DIM)} axes, d = {self.d}")
+        if self._grid is not None:
+            glo = np.array([self._grid._lo[k] for k in range(self.d)])
+            ghi = np.array([self._grid._hi[k] for k in range(self.d)])
+            if not (np.array_equal(glo, self.l_bounds) and np.array_equal(ghi, self.u_bounds)):
+                raise ValueError("workers/tiles: the SizingGrid spans other bounds than the box; "
+                                 "the tiling reads a grid over the box")
+
     # -- lifetime -----------------------------------------------------------------------------
     def reset(self) -> "PoissonDisk":
         """Back to the empty sampling (the fixed points kept), with the same seed."""
+        self._tiled = None
         self._s = None if self.d == 0 else self._new_sampler(self._desc)
         self.num_generated = 0 if self._s is None else int(lib.vpds_count(self._s))
         if self.optimization is not None:
@@ -367,6 +411,8 @@ class PoissonDisk:
         if self._s is None:  # d = 0: scipy's n rows of no coordinates
             self.num_generated += n
             return np.empty((n, 0))
+        if self._tiled is not None or (self.tiles is not None and n > 0):
+            refuse_with_tiles(self, f"random({n})")
         target = self.num_generated + n
         if lib.vpds_count(self._s) < target:
             self._run_until(lambda: lib.vpds_run(self._s), target, "sampling")
@@ -389,6 +435,12 @@ class PoissonDisk:
         one is set. With d = 0 there is nothing to fill: shape (0, 0)."""
         if self._s is None:
             return np.empty((0, 0))
+        if self.tiles is not None:
+            if self._tiled is None:
+                self._tiled = tiled_fill(self, self.tiles, self.workers)
+            out = self._tiled[0][self.num_generated:]
+            self.num_generated += len(out)
+            return self._optimized(out)
         self._run_until(lambda: lib.vpds_run(self._s), None, "filling")
         out = self.points[self.num_generated:]
         self.num_generated += len(out)
@@ -426,6 +478,8 @@ class PoissonDisk:
         continues the refinement and returns all its samples, those of the stopped call included."""
         t = float(t)
         before = int(lib.vpds_count(self._sampler("refine()")))
+        if self.tiles is not None:
+            refuse_with_tiles(self, "refine()")
         st = lib.vpds_get_stats(self._s)
         if self._refining is not None and self._refining[0] == t and st.t == t and not st.maximal:
             before = self._refining[1]
@@ -446,6 +500,8 @@ class PoissonDisk:
         """The continuous decrease (Section 4.2): (point, t) one at a time, the point of shape
         (d,), t non-increasing."""
         self._sampler("stream()")
+        if self.tiles is not None:
+            refuse_with_tiles(self, "stream()")
         x = ffi.new("double[]", self.d)
         t = ffi.new("double *")
         while True:
@@ -469,6 +525,8 @@ class PoissonDisk:
         if n < 0:
             raise ValueError(f"n = {n}: must be >= 0")
         self._sampler("progressive()")
+        if self.tiles is not None:
+            refuse_with_tiles(self, "progressive()")
         desc = ffi.new("vpds_desc *", self._desc[0])
         if inhibition is not None:
             if not 0 < float(inhibition) <= 1:
@@ -495,6 +553,8 @@ class PoissonDisk:
         """Fixed points now (between runs): objects already placed, t = +inf; x of shape (k, d),
         r (k,) or None (the sizing decides)."""
         self._sampler("add_points()")
+        if self.tiles is not None:
+            refuse_with_tiles(self, "add_points()")
         fx = np.ascontiguousarray(x, dtype=np.float64).reshape(-1, self.d)
         fr = None if r is None else np.ascontiguousarray(r, dtype=np.float64).reshape(-1)
         if fr is not None and fr.shape != (len(fx),):
@@ -509,10 +569,20 @@ class PoissonDisk:
         """Samples held by the C sampler (none with d = 0, which has no sampler)."""
         return 0 if self._s is None else int(lib.vpds_count(self._s))
 
+    def _tiled_result(self, column: int) -> Optional[npt.NDArray[np.float64]]:
+        """A copy of a tiled fill's points (0) or radii (1); None for the serial process."""
+        if self._tiled is None:
+            return None
+        values: npt.NDArray[np.float64] = (self._tiled[0] if column == 0 else self._tiled[1]).copy()
+        return values
+
     @property
     def points(self) -> npt.NDArray[np.float64]:
         """All samples so far, insertion order, shape (n, d) (as drawn: before any
         `optimization`)."""
+        tiled = self._tiled_result(0)
+        if tiled is not None:
+            return tiled
         n = self._count()
         if n == 0:
             return np.empty((0, self.d))
@@ -523,18 +593,25 @@ class PoissonDisk:
     @property
     def radii(self) -> npt.NDArray[np.float64]:
         """r at each sample (unscaled), shape (n,)."""
+        tiled = self._tiled_result(1)
+        if tiled is not None:
+            return tiled
         n = self._count()
         return np.frombuffer(ffi.buffer(lib.vpds_radii(self._s), n * 8), dtype=np.float64).copy() if n else np.empty(0)
 
     @property
     def scales(self) -> npt.NDArray[np.float64]:
         """The scale t at which each sample was inserted (inf for fixed points), shape (n,)."""
+        if self._tiled is not None:  # every tile runs at scale 1
+            return np.ones(len(self._tiled[0]))
         n = self._count()
         return np.frombuffer(ffi.buffer(lib.vpds_scales(self._s), n * 8), dtype=np.float64).copy() if n else np.empty(0)
 
     @property
     def fixed(self) -> npt.NDArray[np.bool_]:
         """True where the sample is a fixed point, shape (n,)."""
+        if self._tiled is not None:
+            return np.zeros(len(self._tiled[0]), dtype=bool)
         n = self._count()
         flags = np.frombuffer(ffi.buffer(lib.vpds_flags(self._s), n), dtype=np.uint8) if n else np.empty(0, np.uint8)
         return (flags & 1).astype(bool)
@@ -551,6 +628,10 @@ class PoissonDisk:
 
     @property
     def stats(self) -> dict[str, Union[int, float]]:
+        """The C sampler's statistics; for a tiled fill: samples, tiles and threads."""
+        if self._tiled is not None:
+            return {"samples": len(self._tiled[0]), "tiles": self._tiled[2],
+                    "threads": self._tiled[3], "t": 1.0, "maximal": 1}
         st = lib.vpds_get_stats(self._sampler("stats"))
         return {k: getattr(st, k) for k in ("darts", "accepted", "levels", "peak_active_cells",
                                              "bytes_held", "peak_bytes", "sizing_calls", "delta",

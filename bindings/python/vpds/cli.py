@@ -80,10 +80,10 @@ def _sample(args: argparse.Namespace, engine: PoissonDisk, expected: float) -> N
                 if bar is not None:
                     bar.update(1)
             return
-        while len(engine.random(_STEP)) == _STEP:
+        while engine.tiles is None and len(engine.random(_STEP)) == _STEP:
             if bar is not None:
                 bar.update(_STEP)
-        engine.fill_space()
+        engine.fill_space()  # a tiled engine (--threads) fills the box at once
         for t in [float(v) for v in args.refine.split(",")] if args.refine else []:
             engine.refine(t)
     finally:
@@ -113,12 +113,13 @@ def cmd_sample(args: argparse.Namespace) -> int:
     sizing, meta, arrays = _sizing(args, lo, hi)
     periodic = periodic_arg(args.periodic, dim)
     domain = domain_from_file(Path(args.domain)) if args.domain else None
+    tiled = _threads_options(args)
     try:
         engine = PoissonDisk(dim, radius=args.radius, rng=args.seed, l_bounds=lo, u_bounds=hi,
                              sizing=sizing, lipschitz=None if args.sizing_exr else args.lipschitz,
                              rule=args.rule, inhibition=args.inhibition, coverage=args.coverage,
                              periodic=periodic, progress=False, domain=domain,
-                             domain_threshold=args.domain_threshold)
+                             domain_threshold=args.domain_threshold, **tiled)
     except VpdsError:
         raise  # main prints the C message and exits with 2
     except (ValueError, ImportError, OSError) as exc:  # a domain file or polygon refused
@@ -127,6 +128,8 @@ def cmd_sample(args: argparse.Namespace) -> int:
                 inhibition=args.inhibition, coverage=args.coverage, periodic=periodic,
                 domain=args.domain, domain_threshold=args.domain_threshold if args.domain else None,
                 mode="stream" if args.stream else "refine" if refine else "run", refine=refine)
+    if tiled:
+        meta.update(threads=args.threads, tiles="auto")
     if args.stream:
         from . import STREAM_DOMAIN_TOLERANCE, STREAM_TOLERANCE
         meta["stream_tolerance"] = STREAM_DOMAIN_TOLERANCE if domain is not None else STREAM_TOLERANCE
@@ -158,6 +161,22 @@ def cmd_sample(args: argparse.Namespace) -> int:
         plot_points(Path(args.plot), x, r, lo, hi, f"{len(x)} samples, {what}, {args.rule}")
         print(f"wrote {args.plot}")
     return 0
+
+
+def _threads_options(args: argparse.Namespace) -> dict[str, Any]:
+    """PoissonDisk's workers and radius_max for --threads (the tiled process), checked."""
+    if args.threads is None:
+        return {}
+    if not (args.threads == -1 or args.threads >= 1):
+        raise UsageError(f"--threads {args.threads}: must be >= 1, or -1 for every core")
+    for flag in ("refine", "stream", "domain"):
+        if getattr(args, flag):
+            raise UsageError(f"--{flag.replace('_', '-')} is not available with --threads (the "
+                             "tiled process fills the box at once, without a domain)")
+    if args.sizing and args.radius_max is None:
+        raise UsageError("--sizing with --threads needs --radius-max (an upper bound of r: it "
+                         "sets the margin the tiles share)")
+    return {"workers": args.threads, "radius_max": args.radius_max}
 
 
 def _versions() -> str:
@@ -201,6 +220,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--seed", type=int, default=0, help="the C seed (same seed, same points)")
     s.add_argument("-o", "--output", help="write the samples: .npy, .npz, .csv or .ply")
     s.add_argument("--plot", help="write a PNG of the samples (needs matplotlib)")
+    s.add_argument("--threads", type=int, help="sample the box as tiles on N threads (-1: every "
+                   "core): the tiled process (tiles from the box and radii, the same points for "
+                   "any N), not the serial one; without a domain, --refine or --stream")
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
     s.add_argument("--force", action="store_true", help="run even when the estimated memory "
                    "exceeds what is available")

@@ -34,9 +34,10 @@ def cmd_sample_tiles(args: argparse.Namespace) -> int:
     dim = args.dim
     if not args.output or not args.output.rstrip("/").endswith(".zarr"):
         raise UsageError("--tiles writes a Zarr store: give -o NAME.zarr")
-    for flag in ("refine", "stream", "plot"):
+    for flag in ("refine", "stream", "plot", "threads"):
         if getattr(args, flag):
-            raise UsageError(f"--{flag} is not available with --tiles")
+            raise UsageError(f"--{flag} is not available with --tiles (--tiles runs the tiles on "
+                             "Dask, --workers processes; --threads runs them in this process)")
     try:
         counts = [int(v) for v in args.tiles.split(",")]
     except ValueError:

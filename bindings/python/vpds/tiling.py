@@ -19,6 +19,7 @@ from ._callbacks import raise_failure, take
 from ._core import RULES, SizingGrid
 from ._errors import _raise, created
 from ._scipy_compat import _seed_from
+from ._tiled import check_workers, threads_for
 from ._typing import BoundsLike, RngLike, SizingFunction
 from ._vpds import ffi, lib
 from .gridsource import GridSource
@@ -267,11 +268,7 @@ class Tiling:
         workers, and those of run_tile over order(). A Python sizing callable keeps the run on
         the calling thread (the GIL; a numpy grid or a constant radius runs on every worker);
         a GridSource sizing is refused (its windows are read per tile: use run_tile)."""
-        import os
-        if not isinstance(workers, (int, np.integer)) or isinstance(workers, bool) or \
-                not (workers == -1 or workers >= 1):
-            raise ValueError(f"workers = {workers!r}: must be an int >= 1, or -1 for every core")
-        threads = (os.cpu_count() or 1) if workers == -1 else int(workers)
+        threads = threads_for(check_workers(workers))
         rd = ffi.new("vpds_tiling_run_desc *", lib.vpds_default_tiling_run_desc())
         rd.threads = min(threads, 256)
         out = ffi.new("vpds_tiled **")
