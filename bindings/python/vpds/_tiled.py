@@ -33,6 +33,7 @@ def check_workers(workers: Any) -> int:
 
 
 def threads_for(workers: int) -> int:
+    """Threads for a worker count (-1: every core)."""
     return (os.cpu_count() or 1) if workers == -1 else workers
 
 
@@ -90,7 +91,7 @@ def tiled_fill(engine: Any, tiles: TilesLike, workers: int
         radius_max=float(desc.radius_max) if desc.radius_max > 0 else None, rng=engine.seed)
     tiling = Tiling(spec)
     x, r, _ = tiling.run(workers=workers)
-    return x, r, int(tiling.count), threads_for(workers)
+    return x, r, int(tiling.count), tiling.last_threads
 
 
 def refuse_with_tiles(engine: Any, what: str) -> None:

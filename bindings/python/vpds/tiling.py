@@ -150,6 +150,7 @@ class Tiling:
 
     def __init__(self, spec: TilingSpec) -> None:
         self.spec = spec
+        self.last_threads = 0  # threads the last run() used (vpds_tiled_threads)
         d = spec.d
         self._keep: list[Any] = []
         desc = ffi.new("vpds_desc *", lib.vpds_default_desc())
@@ -280,6 +281,7 @@ class Tiling:
                 _raise(st, ffi.string(msg).decode())
             raise_failure(st, ffi.string(msg).decode(), cause, "sizing")
         res = ffi.gc(out[0], lib.vpds_tiled_destroy)
+        self.last_threads = int(lib.vpds_tiled_threads(res))  # 1 when a callback kept it serial
         n, d = int(lib.vpds_tiled_count(res)), self.spec.d
         if n == 0:
             return np.empty((0, d)), np.empty(0), np.empty(0, dtype=np.int64)
