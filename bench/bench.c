@@ -1,6 +1,8 @@
 #define _POSIX_C_SOURCE 199309L
 /* libvpds workloads for `make bench`. Prints "name n seconds peak_bytes" per line.
  * usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION | ramp RULE | floor N DIM
+ *        | tworamp3 VERSION (3D two radii R_f = 0.5 R_c, r = 0.03 + 0.12 x0, periodic axes 1 and 2,
+ *          rule bigger, at algorithm_version VERSION: a fuzz input's workload)
  *        | annulus RADIUS (a domain) | stream DIM RADIUS N STEPS (prints one line per N/STEPS samples: the cost along n)
  *        | threads DIM RADIUS TILES THREADS (vpds_tiling_run of TILES per axis on THREADS threads)
  *        | mesh square|sphere RADIUS (the unit square as two triangles, or the unit sphere as an
@@ -24,6 +26,7 @@ static double now(void)
 }
 
 static double ramp(const double *x, void *u) { (void)u; return 0.001 + 0.3 * x[0]; }
+static double ramp3(const double *x, void *u) { (void)u; return 0.03 + 0.12 * x[0]; }
 /* the annulus 0.2 <= |x - (0.5, 0.5)| <= 0.45 as a signed distance */
 static double annulus(const double *x, void *u)
 {
@@ -233,6 +236,17 @@ int main(int argc, char **argv)
         d.inhibition = atof(argv[4]);
         return run("tworadii", &d);
     }
+    if (argc >= 3 && !strcmp(argv[1], "tworamp3")) {
+        static const int periodic[3] = {0, 1, 1};
+        d.dim = 3;
+        d.sizing = ramp3;
+        d.lipschitz = 0.12;
+        d.inhibition = 0.5;
+        d.rule = VPDS_RULE_BIGGER;
+        d.periodic = periodic;
+        d.algorithm_version = (uint32_t)atoi(argv[2]);
+        return run("tworamp3", &d);
+    }
     if (argc >= 6 && !strcmp(argv[1], "threads")) {
         d.dim = atoi(argv[2]);
         d.radius = atof(argv[3]);
@@ -290,6 +304,6 @@ int main(int argc, char **argv)
         return 0;
     }
     fprintf(stderr, "usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION | ramp RULE"
-                    " | floor N DIM | stream DIM RADIUS N STEPS | mesh square|sphere RADIUS | meshstream N | meshfile FILE RADIUS\n");
+                    " | tworamp3 VERSION | floor N DIM | stream DIM RADIUS N STEPS | mesh square|sphere RADIUS | meshstream N | meshfile FILE RADIUS\n");
     return 2;
 }
