@@ -132,9 +132,13 @@ fuzz: $(FUZZERS:%=$(FUZZ_OUT)/fuzz_%)
 
 # The corpus replayed without instrumentation, then each harness fuzzed for FUZZ_TEST_SECONDS
 # from its seeds; first, that a harness which crashes, leaks or hangs fails `make fuzz`.
+# fuzz/slow/<name>: regressions too slow under the sanitizers to seed the fuzzer (it would time
+# out on them), replayed here only.
 check-fuzz: $(FUZZERS:%=$(BUILD)/fuzz/replay_%) check-fuzz-fails
 	@set -e; for f in $(FUZZERS); do printf '%-24s' "replay corpus/$$f:"; \
-	  $(BUILD)/fuzz/replay_$$f fuzz/corpus/$$f; done
+	  $(BUILD)/fuzz/replay_$$f fuzz/corpus/$$f; \
+	  if [ -d fuzz/slow/$$f ]; then printf '%-24s' "replay slow/$$f:"; \
+	  $(BUILD)/fuzz/replay_$$f fuzz/slow/$$f; fi; done
 	@FUZZ_SLOW=report $(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(FUZZ_TEST_SECONDS) FUZZ_CORPUS=fresh
 
 check-fuzz-fails: $(FUZZ_LIB_OBJ)
