@@ -1,6 +1,6 @@
 #define _POSIX_C_SOURCE 199309L
 /* libvpds workloads for `make bench`. Prints "name n seconds peak_bytes" per line.
- * usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION | ramp RULE | floor N DIM
+ * usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION [VERSION] | ramp RULE | floor N DIM
  *        | tworamp3 VERSION (3D two radii R_f = 0.5 R_c, r = 0.03 + 0.12 x0, periodic axes 1 and 2,
  *          rule bigger, at algorithm_version VERSION: a fuzz input's workload)
  *        | annulus RADIUS (a domain) | stream DIM RADIUS N STEPS (prints one line per N/STEPS samples: the cost along n)
@@ -234,6 +234,7 @@ int main(int argc, char **argv)
         d.dim = atoi(argv[2]);
         d.radius = atof(argv[3]);
         d.inhibition = atof(argv[4]);
+        if (argc >= 6) d.algorithm_version = (uint32_t)atoi(argv[5]);
         return run("tworadii", &d);
     }
     if (argc >= 3 && !strcmp(argv[1], "tworamp3")) {

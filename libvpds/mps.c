@@ -567,7 +567,7 @@ static vpds_status flag_uncovered(vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned l
                                   const uint64_t *c, int split, unsigned block, int whole_c,
                                   double r_lo, const uint64_t *covered, uint8_t *flag)
 {
-    int d = ctx->pb->dim, learn = ctx->pb->algorithm >= 4, parent = VPDSI_CELL_UNKNOWN;
+    int d = ctx->pb->dim, learn = ctx->pb->algorithm >= 4, parent = VPDSI_CELL_UNKNOWN, indexed;
     unsigned children = block_children(d, split), b;
     uint64_t cov_c[4] = {0, 0, 0, 0}, cc[VPDS_MAX_DIM];
     double scale_c = m->run.t * ctx->pb->coverage, wbuf[VPDS_MAX_DIM + 1];
@@ -576,6 +576,7 @@ static vpds_status flag_uncovered(vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned l
     /* version 4: a parent shown covered has covered children; its witness flags one of them */
     if (learn && (e = vpdsi_uncovered_parent(&m->unc, ctx, m->run.t, m->run.pos, &parent, &pw)) != VPDS_OK)
         return e;
+    indexed = learn && vpdsi_uncovered_indexed(&m->unc, m->run.pos);
     if (whole_c || parent == VPDSI_CELL_COVERED)
         cov_c[0] = cov_c[1] = cov_c[2] = cov_c[3] = ~UINT64_C(0);
     else if (split)
@@ -594,8 +595,10 @@ static vpds_status flag_uncovered(vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned l
             pw = NULL;
             continue;
         }
+        memset(&out, 0, sizeof out);
         out.budget = VPDSI_UNCOVERED_BUDGET;
         out.witness = wbuf;
+        out.in_indexed = indexed;
         if ((e = vpdsi_uncovered_in_box(&m->unc, ctx, m->run.t, clo, chi, 0.0, NULL, &out, &found)) != VPDS_OK)
             return e;
         flag[b] = (uint8_t)found;

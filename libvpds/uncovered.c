@@ -35,7 +35,7 @@ typedef struct {
     double r_anchor, scale, L, reach, slack;
     int point, lists; /* lists: the slots are allocated */
     int exact_region; /* version 2: a box beyond a point anchor's region is dropped */
-    int in_cell;      /* the first box is one indexed cell: the centres cannot prune */
+    int in_cell;      /* the search lies in one indexed cell: the centres cannot prune */
     size_t budget;    /* boxes this search may examine */
     double *witness;  /* where the uncovered point found goes (dim coordinates, then r there) */
     int found_point;  /* *found came from such a point, not from the budget or the precision */
@@ -370,6 +370,7 @@ vpds_status vpdsi_uncovered_in_box(vpdsi_uncovered *u, const vpdsi_ctx *ctx, dou
     if (out) {
         if (out->budget < q.budget) q.budget = out->budget;
         q.witness = out->witness;
+        q.in_cell = q.in_cell || out->in_indexed;
     }
     q.slack = list_slack(ctx->pb, u->stack, u->stack + d);
     e = search(&q, found);

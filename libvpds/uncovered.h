@@ -46,6 +46,8 @@ typedef struct vpdsi_search_out {
     size_t budget;    /* in: boxes it may examine (past them it answers "uncovered") */
     double *witness;  /* in: room for dim + 1 doubles, the point found and r there (or NULL) */
     int found_point;  /* out: *found came from such a point */
+    int in_indexed;   /* in: the anchor box lies in an indexed cell, whose centre is then near
+                         every box of the search: the centres' test is skipped (same answers) */
 } vpdsi_search_out;
 
 static inline vpdsi_kd_samples vpdsi_uncovered_view(const vpdsi_uncovered *u)
@@ -83,6 +85,8 @@ vpds_status vpdsi_uncovered_dart(vpdsi_uncovered *u, const vpdsi_ctx *ctx, doubl
  * need no search), VPDSI_CELL_WITNESS with *witness a point still uncovered, else UNKNOWN. */
 vpds_status vpdsi_uncovered_parent(vpdsi_uncovered *u, const vpdsi_ctx *ctx, double t, size_t pos,
                                    int *state, const double **witness);
+/* Whether active cell `pos` is an indexed cell of a version-4 index (its centre is listed). */
+int vpdsi_uncovered_indexed(const vpdsi_uncovered *u, size_t pos);
 /* Room for `more` sweep records; one record (witness NULL: none) per flagged cell, in order. */
 int vpdsi_uncovered_reserve_records(vpdsi_uncovered *u, vpdsi_mem *m, int dim, size_t more);
 void vpdsi_uncovered_record(vpdsi_uncovered *u, int dim, const double *witness);

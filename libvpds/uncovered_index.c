@@ -159,6 +159,11 @@ static const double *live_witness(vpdsi_uncovered *u, const vpdsi_ctx *ctx, doub
     return NULL;
 }
 
+int vpdsi_uncovered_indexed(const vpdsi_uncovered *u, size_t pos)
+{
+    return u->ready && u->learn && pos < u->n_centre_of && u->centre_of[pos] >= 0;
+}
+
 vpds_status vpdsi_uncovered_parent(vpdsi_uncovered *u, const vpdsi_ctx *ctx, double t, size_t pos,
                                    int *state, const double **witness)
 {
@@ -256,6 +261,7 @@ vpds_status vpdsi_uncovered_dart(vpdsi_uncovered *u, const vpdsi_ctx *ctx, doubl
         uint64_t used = u->boxes - boxes0;
         if (u->state[m] == VPDSI_CELL_COVERED) continue;
         if ((e = cell_image(u, ctx, scale, y, ry, m, box, &whole)) != VPDS_OK) return e;
+        memset(&out, 0, sizeof out);
         out.budget = used < VPDSI_UNCOVERED_BUDGET ? (size_t)(VPDSI_UNCOVERED_BUDGET - used) : 0;
         out.witness = wbuf;
         if ((e = vpdsi_uncovered_in_box(u, ctx, t, y, y, ry, box, &out, &found)) != VPDS_OK) return e;
