@@ -32,6 +32,44 @@ static void check_union(const vpds_tiled *a, const double *lo, const double *hi,
     }
 }
 
+/* The same tiling as a job in steps of at most max_tiles (0: all) on `threads` threads: the
+ * progress grows by at most max_tiles a step, the result is refused before the end, and it is
+ * the bytes of the one-thread run. */
+static void check_job(const vpds_tiling *tg, int threads, uint64_t max_tiles, const vpds_tiled *one)
+{
+    vpds_tiling_run_desc rd = vpds_default_tiling_run_desc();
+    vpds_tiling_job *job = NULL;
+    vpds_tiled *out = NULL;
+    uint64_t before = 0, count = vpds_tiling_count(tg), steps = 0;
+    vpds_status st;
+    char msg[512];
+    rd.threads = threads;
+    rd.callbacks_thread_safe = 1;
+    FUZZ_ASSERT(vpds_tiling_job_create(tg, &rd, &job, msg, sizeof msg) == VPDS_OK, "job: %s", msg);
+    do {
+        uint64_t now;
+        if (before < count)
+            FUZZ_ASSERT(vpds_tiling_job_result(job, &out, msg, sizeof msg) == VPDS_ERR_STATE && !out,
+                        "a result before the end");
+        st = vpds_tiling_job_step(job, max_tiles, msg, sizeof msg);
+        now = vpds_tiling_job_tiles_done(job);
+        FUZZ_ASSERT(now > before && (max_tiles == 0 || now - before <= max_tiles),
+                    "a step of %u tiles went from %llu to %llu", (unsigned)max_tiles,
+                    (unsigned long long)before, (unsigned long long)now);
+        before = now;
+    } while (st == VPDS_PAUSED && ++steps <= count);
+    FUZZ_ASSERT(st == VPDS_OK && before == count, "job ended with %d: %s", (int)st, msg);
+    FUZZ_ASSERT(vpds_tiling_job_result(job, &out, msg, sizeof msg) == VPDS_OK, "result: %s", msg);
+    FUZZ_ASSERT(vpds_tiled_count(out) == vpds_tiled_count(one) &&
+                    memcmp(vpds_tiled_points(out), vpds_tiled_points(one),
+                           vpds_tiled_count(one) * (size_t)vpds_tiled_dim(one) * sizeof(double)) == 0 &&
+                    memcmp(vpds_tiled_tiles(out), vpds_tiled_tiles(one),
+                           vpds_tiled_count(one) * sizeof(uint64_t)) == 0,
+                "a job in steps of %u on %d threads differs from one run", (unsigned)max_tiles, threads);
+    vpds_tiled_destroy(out);
+    vpds_tiling_job_destroy(job);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     bytes_t b = {data, size};
@@ -94,6 +132,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                            vpds_tiled_count(a) * (size_t)d.dim * sizeof(double)) == 0,
                     "%d threads and one differ", rd.threads);
         check_union(a, lo, hi, per, d.rule, d.inhibition, td.scale);
+        check_job(tg, take_u8(&b) % 4, take_u8(&b) % 8, one);
     } else {
         FUZZ_ASSERT(a == NULL && msg[0], "failed without a message or with a result: %d", (int)st);
     }

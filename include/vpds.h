@@ -456,6 +456,28 @@ VPDS_API const uint64_t *vpds_tiled_tiles(const vpds_tiled *tiled);
  * declared thread-safe, or a platform without POSIX threads); with an executor, 0. */
 VPDS_API int vpds_tiled_threads(const vpds_tiled *tiled);
 
+/* The same run in steps, for an engine that spreads it over frames (libvpds/tiling_job.c): each
+ * step runs at most max_tiles more tiles (0: all that are left), side by side within a phase, and
+ * returns VPDS_PAUSED while tiles remain, VPDS_OK once every tile is done. The steps change
+ * nothing: the result is the bytes of vpds_tiling_run for any max_tiles, threads or executor.
+ * A step that fails (a tile's error, out of memory) says which tile and why in msg; the tiles
+ * that succeeded stay done and the next step runs the others again, with the same result. The
+ * tiling must outlive the job; destroying a job before its end is allowed (a cancel). */
+typedef struct vpds_tiling_job vpds_tiling_job;
+
+VPDS_API vpds_status vpds_tiling_job_create(const vpds_tiling *tiling,
+                                            const vpds_tiling_run_desc *desc,
+                                            vpds_tiling_job **out, char *msg, size_t cap);
+VPDS_API vpds_status vpds_tiling_job_step(vpds_tiling_job *job, uint64_t max_tiles, char *msg,
+                                          size_t cap);
+/* Tiles done so far (of vpds_tiling_count): the job's progress. */
+VPDS_API uint64_t vpds_tiling_job_tiles_done(const vpds_tiling_job *job);
+/* Once a step returned VPDS_OK: the samples, as vpds_tiling_run gives them (a new vpds_tiled,
+ * freed with vpds_tiled_destroy); before, VPDS_ERR_STATE. */
+VPDS_API vpds_status vpds_tiling_job_result(const vpds_tiling_job *job, vpds_tiled **out,
+                                            char *msg, size_t cap);
+VPDS_API void vpds_tiling_job_destroy(vpds_tiling_job *job);
+
 /* ---- Surfaces (libvpds/mesh.c, libvpds/surface.c): maximal Poisson-disk sampling of a triangle
  * mesh. The sampled set S is the union of the mesh's triangles of positive area; distances are
  * Euclidean in R^3 and a point y of S conflicts with or is covered by a sample exactly as in the

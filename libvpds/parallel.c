@@ -1,62 +1,19 @@
-/* A whole tiling on several threads: phase after phase, the tiles of one phase side by side
- * (they never interact, tiles.c), each tile a run from its dependencies' samples. A tile's
- * points depend on its seed and its dependencies alone, so the result is the same bytes for
- * any number of threads, any executor and any order in which tasks finish. */
-#include "tiles.h"
+/* The tasks of a tiling run side by side: a batch of tiles that never interact (tiles.c), each a
+ * run from its dependencies' samples, on POSIX threads or on the caller's executor. A tile's
+ * points depend on its seed and its dependencies alone, so they are the same bytes for any number
+ * of threads, any executor and any order in which tasks finish. */
+#include "parallel.h"
 #include "refuse.h"
 #include <stdio.h>
 #include <string.h>
-#if !defined(_WIN32)
-#define VPDSI_THREADS 1
-#include <pthread.h>
-#endif
 
-#define VPDSI_TILED_MAGIC 0x56505450u       /* 'VPTP' */
 #define VPDSI_TILING_RUN_COOKIE 0x56505452u /* 'VPTR': layout 1 of vpds_tiling_run_desc */
 #define MAX_THREADS 256
-
-struct vpds_tiled {
-    uint32_t magic;
-    vpdsi_mem mem;
-    int dim, threads;
-    size_t count;
-    double *x, *r;
-    uint64_t *tile;
-};
-
-/* One tile's own samples. */
-typedef struct {
-    double *x, *r;
-    size_t n;
-} tile_result;
-
-/* The library's lock around an allocator that is not declared thread-safe. */
-typedef struct {
-#ifdef VPDSI_THREADS
-    pthread_mutex_t lock;
-#endif
-    vpds_allocator inner;
-} locked_allocator;
-
-/* A phase: its tiles as tasks, the results of every tile, the next task a thread takes. */
-typedef struct {
-    const vpds_tiling *t;
-    const vpds_allocator *alloc; /* the tiles' allocator (NULL: the tiling's) */
-    tile_result *res;
-    const uint64_t *tasks;
-    uint64_t n_tasks, next;
-    uint64_t failed;      /* the first failing task of the phase (UINT64_MAX: none) */
-    vpds_status failed_st;
-    char failed_msg[512];
-#ifdef VPDSI_THREADS
-    pthread_mutex_t next_lock; /* guards next and the failure */
-#endif
-} phase_batch;
 
 #ifdef VPDSI_THREADS
 static void *locked_alloc(size_t size, void *user)
 {
-    locked_allocator *l = (locked_allocator *)user;
+    vpdsi_locked_allocator *l = (vpdsi_locked_allocator *)user;
     void *p;
     pthread_mutex_lock(&l->lock);
     p = l->inner.alloc(size, l->inner.user);
@@ -65,7 +22,7 @@ static void *locked_alloc(size_t size, void *user)
 }
 static void *locked_realloc(void *ptr, size_t old_size, size_t new_size, void *user)
 {
-    locked_allocator *l = (locked_allocator *)user;
+    vpdsi_locked_allocator *l = (vpdsi_locked_allocator *)user;
     void *p;
     pthread_mutex_lock(&l->lock);
     p = l->inner.realloc(ptr, old_size, new_size, l->inner.user);
@@ -74,7 +31,7 @@ static void *locked_realloc(void *ptr, size_t old_size, size_t new_size, void *u
 }
 static void locked_free(void *ptr, size_t size, void *user)
 {
-    locked_allocator *l = (locked_allocator *)user;
+    vpdsi_locked_allocator *l = (vpdsi_locked_allocator *)user;
     pthread_mutex_lock(&l->lock);
     l->inner.free(ptr, size, l->inner.user);
     pthread_mutex_unlock(&l->lock);
@@ -91,7 +48,7 @@ vpds_tiling_run_desc vpds_default_tiling_run_desc(void)
 }
 
 /* The dependencies' own samples, handed to the tile's run (res of earlier phases). */
-static vpds_status tile_deps(const phase_batch *b, uint64_t tile, vpdsi_mem *m, uint64_t **dep,
+static vpds_status tile_deps(const vpdsi_batch *b, uint64_t tile, vpdsi_mem *m, uint64_t **dep,
                              vpds_tile_points **pts, size_t *nd, size_t *cap)
 {
     size_t i;
@@ -101,7 +58,7 @@ static vpds_status tile_deps(const phase_batch *b, uint64_t tile, vpdsi_mem *m, 
     if (!*dep || !*pts) return VPDS_ERR_OUT_OF_MEMORY;
     *nd = vpdsi_tiling_deps_into(b->t, tile, *dep); /* allocates nothing: no unlocked call */
     for (i = 0; i < *nd; i++) {
-        const tile_result *o = &b->res[(*dep)[i]];
+        const vpdsi_tile_result *o = &b->res[(*dep)[i]];
         (*pts)[i].tile = (*dep)[i];
         (*pts)[i].x = o->x;
         (*pts)[i].r = o->r;
@@ -112,7 +69,7 @@ static vpds_status tile_deps(const phase_batch *b, uint64_t tile, vpdsi_mem *m, 
 
 /* Keep the tile's own samples (those after its fixed points). */
 static vpds_status keep_own(const vpds_sampler *s, size_t n_fixed, int dim, vpdsi_mem *m,
-                            tile_result *out)
+                            vpdsi_tile_result *out)
 {
     size_t n = vpds_count(s) - n_fixed, nx = 0;
     if (vpdsi_mul_size(n ? n : 1, (size_t)dim, &nx) ||
@@ -129,7 +86,7 @@ static vpds_status keep_own(const vpds_sampler *s, size_t n_fixed, int dim, vpds
 }
 
 /* A failing task: the phase keeps the message of the first in task order. */
-static void note_failure(phase_batch *b, uint64_t i, vpds_status st, const char *msg)
+static void note_failure(vpdsi_batch *b, uint64_t i, vpds_status st, const char *msg)
 {
 #ifdef VPDSI_THREADS
     pthread_mutex_lock(&b->next_lock);
@@ -147,9 +104,9 @@ static void note_failure(phase_batch *b, uint64_t i, vpds_status st, const char 
 /* Task i of a phase: run its tile to completion (pauses of the tile's budget resumed). */
 static void run_task(void *batch, uint64_t i)
 {
-    phase_batch *b = (phase_batch *)batch;
+    vpdsi_batch *b = (vpdsi_batch *)batch;
     uint64_t tile = b->tasks[i], *dep = NULL;
-    tile_result *out = &b->res[tile];
+    vpdsi_tile_result *out = &b->res[tile];
     vpds_tile_points *pts = NULL;
     vpds_sampler *s = NULL;
     vpdsi_mem m;
@@ -168,7 +125,10 @@ static void run_task(void *batch, uint64_t i)
         else if ((st = keep_own(s, n_fixed, b->t->dim, &m, out)) != VPDS_OK)
             snprintf(msg, sizeof msg, "out of memory for its samples");
     }
-    if (st != VPDS_OK) note_failure(b, i, st, msg);
+    if (st != VPDS_OK)
+        note_failure(b, i, st, msg);
+    else
+        b->done[tile] = 1; /* one byte per tile: tasks write apart */
     if (s) vpds_destroy(s);
     if (dep) vpdsi_mem_free(&m, dep, cap * sizeof *dep);
     if (pts) vpdsi_mem_free(&m, pts, cap * sizeof *pts);
@@ -178,7 +138,7 @@ static void run_task(void *batch, uint64_t i)
 /* A worker: take the next task until none is left. */
 static void *work(void *batch)
 {
-    phase_batch *b = (phase_batch *)batch;
+    vpdsi_batch *b = (vpdsi_batch *)batch;
     for (;;) {
         uint64_t i;
         pthread_mutex_lock(&b->next_lock);
@@ -190,10 +150,10 @@ static void *work(void *batch)
 }
 #endif
 
-/* Run the phase's tasks on `threads` threads (the calling one among them), or the executor. */
-static void dispatch(phase_batch *b, int threads, const vpds_tiling_run_desc *d)
+void vpdsi_batch_run(vpdsi_batch *b, int threads, const vpds_tiling_run_desc *d)
 {
     uint64_t i;
+    b->failed = UINT64_MAX;
     if (d->executor && threads == 0) { /* 1: kept serial (threads_for) */
         d->executor(run_task, b, b->n_tasks, d->executor_user);
         return;
@@ -214,8 +174,7 @@ static void dispatch(phase_batch *b, int threads, const vpds_tiling_run_desc *d)
     for (i = 0; i < b->n_tasks; i++) run_task(b, i);
 }
 
-/* Threads to use: one when a callback (sizing, domain, progress) is not declared thread-safe. */
-static int threads_for(const vpds_tiling *t, const vpds_tiling_run_desc *d)
+int vpdsi_run_threads(const vpds_tiling *t, const vpds_tiling_run_desc *d)
 {
     const vpds_desc *s = &t->desc;
     int callbacks = s->sizing || s->sizing_batch || s->domain || s->progress;
@@ -228,7 +187,7 @@ static int threads_for(const vpds_tiling *t, const vpds_tiling_run_desc *d)
 #endif
 }
 
-static vpds_status check_run_desc(const vpds_tiling *t, const vpds_tiling_run_desc *d, char *msg,
+vpds_status vpdsi_check_run_desc(const vpds_tiling *t, const vpds_tiling_run_desc *d, char *msg,
                                   size_t cap)
 {
     if (!t || t->magic != VPDSI_TILING_MAGIC)
@@ -248,7 +207,7 @@ static vpds_status check_run_desc(const vpds_tiling *t, const vpds_tiling_run_de
     return VPDS_OK;
 }
 
-static void free_results(const vpds_tiling *t, tile_result *res, const vpds_allocator *alloc)
+void vpdsi_free_results(const vpds_tiling *t, vpdsi_tile_result *res, const vpds_allocator *alloc)
 {
     vpdsi_mem m;
     uint64_t i;
@@ -260,152 +219,54 @@ static void free_results(const vpds_tiling *t, tile_result *res, const vpds_allo
     }
 }
 
-/* The tiles' samples in (phase, tile, insertion) order, into one vpds_tiled. */
-static vpds_status assemble(const vpds_tiling *t, const tile_result *res, const uint64_t *order,
-                            int threads, vpds_tiled **out, char *msg, size_t cap)
+vpds_status vpdsi_locked_allocator_init(vpdsi_locked_allocator *l, const vpds_tiling *t,
+                                        const vpds_tiling_run_desc *d, int threads,
+                                        const vpds_allocator **use)
 {
-    vpdsi_mem m = t->mem;
-    vpds_tiled *r;
-    size_t total = 0, at = 0, nx = 0, d = (size_t)t->dim;
-    uint64_t i;
-    for (i = 0; i < t->count; i++) total += res[i].n;
-    if (!(r = (vpds_tiled *)vpdsi_mem_alloc(&m, sizeof *r)))
-        VPDSI_REFUSE(VPDS_ERR_OUT_OF_MEMORY, "out of memory for the result");
-    memset(r, 0, sizeof *r);
-    if (vpdsi_mul_size(total ? total : 1, d * sizeof(double), &nx) ||
-        !(r->x = (double *)vpdsi_mem_alloc(&m, nx)) ||
-        !(r->r = (double *)vpdsi_mem_alloc(&m, (total ? total : 1) * sizeof(double))) ||
-        !(r->tile = (uint64_t *)vpdsi_mem_alloc(&m, (total ? total : 1) * sizeof(uint64_t)))) {
-        if (r->x) vpdsi_mem_free(&m, r->x, nx);
-        if (r->r) vpdsi_mem_free(&m, r->r, (total ? total : 1) * sizeof(double));
-        vpdsi_mem_free(&m, r, sizeof *r);
-        VPDSI_REFUSE(VPDS_ERR_OUT_OF_MEMORY, "out of memory for the %zu samples of the result", total);
+    memset(l, 0, sizeof *l);
+    *use = NULL;
+#ifdef VPDSI_THREADS
+    if (threads != 1 && t->desc.allocator.alloc && !d->allocator_thread_safe) {
+        l->inner = t->mem.a;
+        if (pthread_mutex_init(&l->lock, NULL) != 0) return VPDS_ERR_OUT_OF_MEMORY;
+        l->live = 1;
+        l->wrapped.alloc = locked_alloc;
+        l->wrapped.realloc = l->inner.realloc ? locked_realloc : NULL;
+        l->wrapped.free = locked_free;
+        l->wrapped.user = l;
+        *use = &l->wrapped;
     }
-    for (i = 0; i < t->count; i++) {
-        const tile_result *o = &res[order[i]];
-        size_t j;
-        memcpy(r->x + at * d, o->x, o->n * d * sizeof(double));
-        memcpy(r->r + at, o->r, o->n * sizeof(double));
-        for (j = 0; j < o->n; j++) r->tile[at + j] = order[i];
-        at += o->n;
-    }
-    r->mem = m;
-    r->dim = t->dim;
-    r->threads = threads;
-    r->count = total;
-    r->magic = VPDSI_TILED_MAGIC;
-    *out = r;
+#else
+    (void)t;
+    (void)d;
+    (void)threads;
+#endif
     return VPDS_OK;
 }
 
-/* Every phase in turn; on the first failing tile (in phase, tile order) say which and why. */
-static vpds_status run_phases(phase_batch *b, uint64_t *order, int threads,
-                              const vpds_tiling_run_desc *d, char *msg, size_t cap)
+void vpdsi_locked_allocator_destroy(vpdsi_locked_allocator *l)
 {
-    const vpds_tiling *t = b->t;
-    uint64_t i, placed = 0;
-    int phase, phases = 1 << t->dim;
-    for (phase = 0; phase < phases; phase++) {
-        uint64_t first = placed;
-        for (i = 0; i < t->count; i++)
-            if (vpds_tiling_phase(t, i) == phase) order[placed++] = i;
-        b->tasks = order + first;
-        b->n_tasks = placed - first;
-        b->failed = UINT64_MAX;
-        if (b->n_tasks == 0) continue;
-        dispatch(b, threads, d);
-        if (b->failed != UINT64_MAX)
-            VPDSI_REFUSE(b->failed_st, "tile %llu (phase %d): %s",
-                         (unsigned long long)b->tasks[b->failed], phase, b->failed_msg);
-    }
+#ifdef VPDSI_THREADS
+    if (l->live) pthread_mutex_destroy(&l->lock);
+#endif
+    l->live = 0;
+}
+
+vpds_status vpdsi_batch_init(vpdsi_batch *b, const vpds_tiling *t)
+{
+    memset(b, 0, sizeof *b);
+    b->t = t;
+    b->failed = UINT64_MAX;
+#ifdef VPDSI_THREADS
+    if (pthread_mutex_init(&b->next_lock, NULL) != 0) return VPDS_ERR_OUT_OF_MEMORY;
+#endif
     return VPDS_OK;
 }
 
-vpds_status vpds_tiling_run(const vpds_tiling *t, const vpds_tiling_run_desc *desc, vpds_tiled **out,
-                            char *msg, size_t cap)
+void vpdsi_batch_destroy(vpdsi_batch *b)
 {
-    vpds_tiling_run_desc d = desc ? *desc : vpds_default_tiling_run_desc();
-    vpdsi_mem m;
-    phase_batch b;
-    locked_allocator lock;
-    vpds_allocator wrapped;
-    tile_result *res = NULL;
-    uint64_t *order = NULL;
-    size_t res_bytes = 0, order_bytes = 0;
-    vpds_status st;
-    int threads, locked = 0;
-    if (msg && cap) msg[0] = 0;
-    if (!out) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "out is NULL");
-    *out = NULL;
-    if ((st = check_run_desc(t, &d, msg, cap)) != VPDS_OK) return st;
-    threads = threads_for(t, &d);
-    memset(&b, 0, sizeof b);
-    memset(&wrapped, 0, sizeof wrapped);
-    memset(&lock, 0, sizeof lock);
-    b.t = t;
 #ifdef VPDSI_THREADS
-    if (threads != 1 && t->desc.allocator.alloc && !d.allocator_thread_safe) {
-        lock.inner = t->mem.a;
-        if (pthread_mutex_init(&lock.lock, NULL) != 0)
-            VPDSI_REFUSE(VPDS_ERR_OUT_OF_MEMORY, "could not make the allocator's lock");
-        locked = 1;
-        wrapped.alloc = locked_alloc;
-        wrapped.realloc = lock.inner.realloc ? locked_realloc : NULL;
-        wrapped.free = locked_free;
-        wrapped.user = &lock;
-        b.alloc = &wrapped;
-    }
-    if (pthread_mutex_init(&b.next_lock, NULL) != 0) {
-        if (locked) pthread_mutex_destroy(&lock.lock);
-        VPDSI_REFUSE(VPDS_ERR_OUT_OF_MEMORY, "could not make the task queue's lock");
-    }
+    pthread_mutex_destroy(&b->next_lock);
 #endif
-    m = t->mem;
-    if ((uint64_t)(size_t)t->count != t->count ||
-        vpdsi_mul_size((size_t)t->count, sizeof *res, &res_bytes) ||
-        vpdsi_mul_size((size_t)t->count, sizeof *order, &order_bytes)) {
-        st = VPDS_ERR_OVERFLOW;
-        if (msg && cap) snprintf(msg, cap, "%llu tiles: their records overflow the address space",
-                                 (unsigned long long)t->count);
-    } else if (!(res = (tile_result *)vpdsi_mem_alloc(&m, res_bytes)) ||
-               !(order = (uint64_t *)vpdsi_mem_alloc(&m, order_bytes))) {
-        st = VPDS_ERR_OUT_OF_MEMORY;
-        if (msg && cap) snprintf(msg, cap, "out of memory for %llu tiles", (unsigned long long)t->count);
-    } else {
-        memset(res, 0, res_bytes);
-        b.res = res;
-        if ((st = run_phases(&b, order, threads, &d, msg, cap)) == VPDS_OK)
-            st = assemble(t, res, order, threads, out, msg, cap);
-    }
-    if (b.res) free_results(t, b.res, b.alloc); /* set once res is zeroed */
-    if (res) vpdsi_mem_free(&m, res, res_bytes);
-    if (order) vpdsi_mem_free(&m, order, order_bytes);
-#ifdef VPDSI_THREADS
-    pthread_mutex_destroy(&b.next_lock);
-    if (locked) pthread_mutex_destroy(&lock.lock);
-#endif
-    return st;
+    (void)b;
 }
-
-static int tiled_live(const vpds_tiled *r) { return r && r->magic == VPDSI_TILED_MAGIC; }
-
-void vpds_tiled_destroy(vpds_tiled *r)
-{
-    vpdsi_mem m;
-    size_t n;
-    if (!tiled_live(r)) return;
-    m = r->mem;
-    n = r->count ? r->count : 1;
-    vpdsi_mem_free(&m, r->x, n * (size_t)r->dim * sizeof(double));
-    vpdsi_mem_free(&m, r->r, n * sizeof(double));
-    vpdsi_mem_free(&m, r->tile, n * sizeof(uint64_t));
-    r->magic = 0;
-    vpdsi_mem_free(&m, r, sizeof *r);
-}
-
-size_t vpds_tiled_count(const vpds_tiled *r) { return tiled_live(r) ? r->count : 0; }
-int vpds_tiled_dim(const vpds_tiled *r) { return tiled_live(r) ? r->dim : 0; }
-const double *vpds_tiled_points(const vpds_tiled *r) { return tiled_live(r) ? r->x : NULL; }
-const double *vpds_tiled_radii(const vpds_tiled *r) { return tiled_live(r) ? r->r : NULL; }
-const uint64_t *vpds_tiled_tiles(const vpds_tiled *r) { return tiled_live(r) ? r->tile : NULL; }
-int vpds_tiled_threads(const vpds_tiled *r) { return tiled_live(r) ? r->threads : 0; }

@@ -2,7 +2,8 @@
  * for 1-4 threads and for executors that finish tasks in reverse and shuffled orders; the union
  * conflict-free and covered by brute force; callbacks not declared thread-safe keep it serial;
  * a caller's allocator behind the library's lock; an allocation failure anywhere fails the run
- * cleanly; every refused argument. Run under ThreadSanitizer by make test. */
+ * cleanly; the same run as a job in steps (vpds_tiling_job_*) gives the same bytes, and goes on
+ * after a failed step to them; every refused argument. Run under ThreadSanitizer by make test. */
 #include "check.h"
 #include "vpds.h"
 #include <math.h>
@@ -149,6 +150,44 @@ static void check_guarantees(const vpds_tiled *a, int dim, double inhibition, co
     }
 }
 
+/* The tiling as a job in steps of at most max_tiles tiles on `threads` threads: the progress
+ * grows by at most max_tiles a step, the result exists only at the end, and it is the bytes of
+ * the serial union. */
+static void check_job(const vpds_tiling *tg, int threads, uint64_t max_tiles, const double *ref,
+                      size_t n, int dim)
+{
+    vpds_tiling_run_desc rd = vpds_default_tiling_run_desc();
+    vpds_tiling_job *job = NULL;
+    vpds_tiled *a = NULL;
+    uint64_t count = vpds_tiling_count(tg), before = 0, steps = 0;
+    vpds_status st;
+    char msg[512];
+    rd.threads = threads;
+    rd.callbacks_thread_safe = 1;
+    CHECK_MSG(vpds_tiling_job_create(tg, &rd, &job, msg, sizeof msg) == VPDS_OK, "%s", msg);
+    if (!job) return;
+    CHECK(vpds_tiling_job_result(job, &a, msg, sizeof msg) == VPDS_ERR_STATE && !a);
+    CHECK(strstr(msg, "0 of ") != NULL);
+    do {
+        uint64_t now;
+        st = vpds_tiling_job_step(job, max_tiles, msg, sizeof msg);
+        now = vpds_tiling_job_tiles_done(job);
+        CHECK_MSG(now > before && now - before <= max_tiles, "a step of %llu did %llu tiles",
+                  (unsigned long long)max_tiles, (unsigned long long)(now - before));
+        before = now;
+        steps++;
+    } while (st == VPDS_PAUSED && steps <= count);
+    CHECK_MSG(st == VPDS_OK && before == count, "%d after %llu steps: %s", (int)st,
+              (unsigned long long)steps, msg);
+    CHECK(steps >= (count + max_tiles - 1) / max_tiles);
+    CHECK(vpds_tiling_job_step(job, max_tiles, msg, sizeof msg) == VPDS_OK); /* nothing left */
+    CHECK(vpds_tiling_job_result(job, &a, msg, sizeof msg) == VPDS_OK);
+    CHECK_MSG(same_points(a, ref, n, dim), "%dD job, steps of %llu tiles on %d threads: not the serial bytes",
+              dim, (unsigned long long)max_tiles, threads);
+    vpds_tiled_destroy(a);
+    vpds_tiling_job_destroy(job);
+}
+
 /* One tiling: every way of running it gives the serial union's bytes. */
 static void check_tiling(int dim, uint64_t tiles_per_axis, double inhibition, int callback,
                          const int *periodic)
@@ -185,6 +224,9 @@ static void check_tiling(int dim, uint64_t tiles_per_axis, double inhibition, in
         if (threads == 2) check_guarantees(a, dim, inhibition, periodic, callback ? 0 : d.radius);
         vpds_tiled_destroy(a);
     }
+    check_job(tg, 1, 1, ref, n, dim);
+    check_job(tg, 2, 3, ref, n, dim);
+    check_job(tg, 3, vpds_tiling_count(tg) - 1, ref, n, dim);
     a = run_with(tg, 0, reverse_executor, NULL, 1);
     CHECK(same_points(a, ref, n, dim) && vpds_tiled_threads(a) == 0);
     vpds_tiled_destroy(a);
@@ -270,6 +312,38 @@ static void check_allocator(void)
         c.fail_at = 0;
     }
     CHECK_MSG(failures > (quick() ? 5u : 10u), "only %zu of the sampled allocations failed the run", failures);
+    /* a job whose step fails goes on where it stopped: the next steps give the same bytes; a
+     * job destroyed half way leaves nothing */
+    for (k = 1, failures = 0; k < calls; k += 1 + calls / (quick() ? 10 : 30)) {
+        vpds_tiling_job *job = NULL;
+        int steps = 0, failed = 0;
+        rd.threads = 2;
+        if (vpds_tiling_job_create(tg, &rd, &job, msg, sizeof msg) != VPDS_OK) continue;
+        c.fail_at = c.calls + k;
+        while ((st = vpds_tiling_job_step(job, 2, msg, sizeof msg)) != VPDS_OK && steps++ < 100) {
+            if (st == VPDS_PAUSED) continue;
+            CHECK_MSG(st == VPDS_ERR_OUT_OF_MEMORY && strstr(msg, "tile ") == msg, "%d %s", (int)st, msg);
+            failed = 1;
+            c.fail_at = 0;
+        }
+        failures += (size_t)failed;
+        c.fail_at = 0;
+        b = NULL;
+        CHECK(st == VPDS_OK && vpds_tiling_job_result(job, &b, msg, sizeof msg) == VPDS_OK);
+        CHECK_MSG(b && vpds_tiled_count(b) == vpds_tiled_count(a) &&
+                      memcmp(vpds_tiled_points(b), vpds_tiled_points(a),
+                             vpds_tiled_count(a) * 2 * sizeof(double)) == 0,
+                  "k = %zu: a job resumed after a failed step gave other points", k);
+        vpds_tiled_destroy(b);
+        vpds_tiling_job_destroy(job);
+    }
+    CHECK_MSG(failures > 3, "only %zu jobs saw a failed step", failures);
+    {
+        vpds_tiling_job *job = NULL;
+        CHECK(vpds_tiling_job_create(tg, &rd, &job, msg, sizeof msg) == VPDS_OK);
+        CHECK(vpds_tiling_job_step(job, 4, msg, sizeof msg) == VPDS_PAUSED);
+        vpds_tiling_job_destroy(job); /* a cancel */
+    }
     vpds_tiled_destroy(a);
     CHECK_MSG(c.live == held, "%zu bytes left after the failures", c.live - held);
     vpds_tiling_destroy(tg);
@@ -307,6 +381,24 @@ static void check_refusals(void)
     vpds_tiled_destroy(a);
     vpds_tiled_destroy(NULL);
     CHECK(vpds_tiled_count(NULL) == 0 && vpds_tiled_points(NULL) == NULL && vpds_tiled_threads(NULL) == 0);
+    {
+        vpds_tiling_job *job = NULL;
+        CHECK(vpds_tiling_job_create(tg, NULL, NULL, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT);
+        CHECK(vpds_tiling_job_create(NULL, NULL, &job, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT && !job);
+        rd = vpds_default_tiling_run_desc();
+        rd.threads = -2;
+        CHECK(vpds_tiling_job_create(tg, &rd, &job, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT && !job);
+        CHECK(strstr(msg, "threads = -2") != NULL);
+        CHECK(vpds_tiling_job_step(NULL, 0, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT);
+        CHECK(strstr(msg, "job") != NULL);
+        CHECK(vpds_tiling_job_result(NULL, &a, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT && !a);
+        CHECK(vpds_tiling_job_tiles_done(NULL) == 0);
+        vpds_tiling_job_destroy(NULL);
+        CHECK(vpds_tiling_job_create(tg, NULL, &job, msg, sizeof msg) == VPDS_OK);
+        CHECK(vpds_tiling_job_result(job, NULL, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT);
+        CHECK(vpds_tiling_job_step(job, 0, msg, sizeof msg) == VPDS_OK && vpds_tiling_job_tiles_done(job) == 4);
+        vpds_tiling_job_destroy(job);
+    }
     vpds_tiling_destroy(tg);
     /* windows per tile come from the caller */
     d.radius_max = 0.05;
