@@ -5,6 +5,8 @@
  *          rule bigger, at algorithm_version VERSION: a fuzz input's workload)
  *        | annulus RADIUS (a domain) | stream DIM RADIUS N STEPS (prints one line per N/STEPS samples: the cost along n)
  *        | threads DIM RADIUS TILES THREADS (vpds_tiling_run of TILES per axis on THREADS threads)
+ *        | tilestats DIM RADIUS TILES (the speed-up model's inputs: one run, each phase's tile work
+ *          and largest tile, and the bounds it gives for 2, 16, 64, 1024 workers)
  *        | mesh square|sphere RADIUS (the unit square as two triangles, or the unit sphere as an
  *          icosahedron split into 40^2 triangles per face: vpds_mesh_run)
  *        | meshstream N (N calls of vpds_mesh_next on that sphere)
@@ -102,6 +104,82 @@ static int tiled(vpds_desc *d, uint64_t per_axis, int threads)
         return 1;
     }
     printf("threads %zu %.6f 0\n", vpds_tiled_count(out), now() - t0);
+    vpds_tiled_destroy(out);
+    vpds_tiling_destroy(tg);
+    return 0;
+}
+
+/* tilestats: an executor that runs each batch (a phase) serially, timing every task. */
+typedef struct {
+    double sum[1 << VPDS_MAX_DIM], max[1 << VPDS_MAX_DIM];
+    int phases;
+} tile_times;
+
+static void timing_executor(vpds_task_fn run, void *batch, uint64_t n, void *user)
+{
+    tile_times *tt = (tile_times *)user;
+    uint64_t i;
+    int p = tt->phases++;
+    tt->sum[p] = tt->max[p] = 0;
+    for (i = 0; i < n; i++) {
+        double t0 = now(), dt;
+        run(batch, i);
+        dt = now() - t0;
+        tt->sum[p] += dt;
+        if (dt > tt->max[p]) tt->max[p] = dt;
+    }
+}
+
+/* The inputs of the speed-up model (README, "Expected speed-up"): one run of the box (W1), the
+ * tiles' work per phase (W_p) and its largest tile (m_p), and, for T workers, the greedy
+ * schedule's bounds per phase, max(W_p / T, m_p) <= phase time <= W_p / T + m_p (Graham). */
+static int tilestats(vpds_desc *d, uint64_t per_axis)
+{
+    static const int workers[4] = {2, 16, 64, 1024};
+    vpds_tiling_desc td = vpds_default_tiling_desc();
+    vpds_tiling_run_desc rd = vpds_default_tiling_run_desc();
+    uint64_t tiles[VPDS_MAX_DIM];
+    vpds_tiling *tg;
+    vpds_tiled *out;
+    vpds_sampler *s;
+    tile_times tt;
+    double t0, w1, wall, work = 0;
+    char msg[512];
+    int k, p, w;
+    memset(&tt, 0, sizeof tt);
+    if (vpds_create(d, &s) != VPDS_OK) return 1;
+    t0 = now();
+    while (vpds_run(s) == VPDS_PAUSED) {}
+    w1 = now() - t0;
+    printf("one run: %zu samples in %.3f s\n", vpds_count(s), w1);
+    vpds_destroy(s);
+    for (k = 0; k < d->dim; k++) tiles[k] = per_axis;
+    td.sampler = d;
+    td.tiles = tiles;
+    rd.executor = timing_executor;
+    rd.executor_user = &tt;
+    if (vpds_tiling_create(&td, &tg) != VPDS_OK) return 1;
+    t0 = now();
+    if (vpds_tiling_run(tg, &rd, &out, msg, sizeof msg) != VPDS_OK) {
+        fprintf(stderr, "tilestats: %s\n", msg);
+        return 1;
+    }
+    wall = now() - t0;
+    for (p = 0; p < tt.phases; p++) work += tt.sum[p];
+    printf("tiled: %zu samples, %llu tiles, %d phases; tiles' work %.3f s (%.3fx one run), "
+           "outside the tiles %.3f s\n", vpds_tiled_count(out), (unsigned long long)vpds_tiling_count(tg),
+           tt.phases, work, work / w1, wall - work);
+    for (p = 0; p < tt.phases; p++)
+        printf("  phase %d: work %.4f s, largest tile %.4f s\n", p, tt.sum[p], tt.max[p]);
+    for (w = 0; w < 4; w++) {
+        double lo = 0, hi = 0;
+        for (p = 0; p < tt.phases; p++) {
+            double even = tt.sum[p] / workers[w];
+            lo += even > tt.max[p] ? even : tt.max[p];
+            hi += even + tt.max[p];
+        }
+        printf("  %4d workers: speed-up over one run between %.2f and %.2f\n", workers[w], w1 / hi, w1 / lo);
+    }
     vpds_tiled_destroy(out);
     vpds_tiling_destroy(tg);
     return 0;
@@ -252,6 +330,11 @@ int main(int argc, char **argv)
         d.dim = atoi(argv[2]);
         d.radius = atof(argv[3]);
         return tiled(&d, (uint64_t)atoi(argv[4]), atoi(argv[5]));
+    }
+    if (argc >= 5 && !strcmp(argv[1], "tilestats")) {
+        d.dim = atoi(argv[2]);
+        d.radius = atof(argv[3]);
+        return tilestats(&d, (uint64_t)atoi(argv[4]));
     }
     if (argc >= 3 && !strcmp(argv[1], "annulus")) {
         d.radius = atof(argv[2]);

@@ -130,3 +130,53 @@ def test_cli_threads(tmp_path):
                            "--threads is not available with --tiles")):
         res = vpds_cli("sample", *args, "--no-progress")
         assert res.returncode == 2 and message in res.stderr and "Traceback" not in res.stderr
+
+
+def test_tiling_run_reports_progress_and_stops_on_an_exception():
+    """Tiling.run works in C calls of at most 16 tiles per thread: progress(done, total) after
+    each, growing to the total; an exception raised there (Ctrl-C is a KeyboardInterrupt) stops
+    the run at once, and a new run gives the bytes of an uninterrupted one."""
+    spec = TilingSpec.make(2, (12, 12), radius=0.004, rng=21)
+    tiling = Tiling(spec)
+    ref = tiling.run(workers=2)
+    seen = []
+    x = tiling.run(workers=2, progress=lambda done, total: seen.append((done, total)))
+    assert all(np.array_equal(a, b) for a, b in zip(x, ref))
+    done = [d for d, _ in seen]
+    assert {t for _, t in seen} == {144} and done[-1] == 144
+    assert all(0 < b - a <= 32 for a, b in zip([0] + done, done)), done
+    assert len(seen) >= 144 // 32
+
+    calls = []
+
+    def interrupt(done, total):
+        calls.append(done)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        tiling.run(workers=1, progress=interrupt)
+    assert calls == [16, 32]  # stopped after the second call of 16 tiles
+    again = tiling.run(workers=1)
+    assert all(np.array_equal(a, b) for a, b in zip(again, ref))
+
+
+def test_a_tiled_fill_shows_its_tiles_on_the_progress_bar(monkeypatch):
+    tqdm_auto = pytest.importorskip("tqdm.auto")
+    bars = []
+
+    class Bar:
+        def __init__(self, **kw):
+            self.kw, self.n, self.closed = kw, 0, False
+            bars.append(self)
+
+        def update(self, k):
+            self.n += k
+
+        def close(self):
+            self.closed = True
+
+    monkeypatch.setattr(tqdm_auto, "tqdm", Bar)
+    x = vpds.PoissonDisk(2, radius=0.01, rng=2, workers=2, tiles=6, progress=True).fill_space()
+    assert np.array_equal(x, fill(d=2, radius=0.01, rng=2, workers=2, tiles=6))
+    assert len(bars) == 1 and bars[0].kw["total"] == 36 and bars[0].n == 36 and bars[0].closed

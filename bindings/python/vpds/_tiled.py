@@ -90,7 +90,19 @@ def tiled_fill(engine: Any, tiles: TilesLike, workers: int
         radius_min=float(desc.radius_min) if desc.radius_min > 0 else None,
         radius_max=float(desc.radius_max) if desc.radius_max > 0 else None, rng=engine.seed)
     tiling = Tiling(spec)
-    x, r, _ = tiling.run(workers=workers)
+    bar = None
+    if engine.progress:
+        try:
+            from tqdm.auto import tqdm
+            bar = tqdm(desc="filling", total=int(tiling.count), unit=" tiles", leave=False)
+        except ImportError:
+            bar = None
+    try:
+        x, r, _ = tiling.run(workers=workers,
+                             progress=None if bar is None else lambda done, total: bar.update(done - bar.n))
+    finally:
+        if bar is not None:
+            bar.close()
     return x, r, int(tiling.count), tiling.last_threads
 
 

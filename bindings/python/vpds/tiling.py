@@ -26,6 +26,11 @@ from .gridsource import GridSource
 
 __all__ = ["TilingSpec", "Tiling"]
 
+# tiles per thread in one C call of Tiling.run: a phase is cut into batches of this many, each
+# ended by its largest tile, so larger keeps the threads busy and smaller answers Ctrl-C and
+# the progress sooner
+_STEP_TILES_PER_THREAD = 16
+
 #: what `sizing` takes (TilingSpec.make, distributed.sample): see TilingSpec
 SizingArg = Union[None, float, npt.NDArray[Any], SizingGrid, GridSource, SizingFunction]
 
@@ -261,25 +266,43 @@ class Tiling:
         """All tiles in an order that can run one after another: by phase, then index."""
         return sorted(range(self.count), key=lambda k: (self.phase(k), k))
 
-    def run(self, workers: int = 1) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64],
-                                           npt.NDArray[np.int64]]:
+    def run(self, workers: int = 1, progress: Optional[Callable[[int, int], None]] = None
+            ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.int64]]:
         """Every tile, in this process: points (n, d), radii (n,) and the tile of each sample
-        (n,), in the order (phase, tile, insertion), by the C library's vpds_tiling_run on
+        (n,), in the order (phase, tile, insertion), by the C library's tiling job on
         `workers` threads (-1: every core; scipy's spelling). The same bytes for any number of
         workers, and those of run_tile over order(). A Python sizing callable keeps the run on
         the calling thread (the GIL; a numpy grid or a constant radius runs on every worker);
-        a GridSource sizing is refused (its windows are read per tile: use run_tile)."""
+        a GridSource sizing is refused (its windows are read per tile: use run_tile).
+
+        The job runs a few tiles per C call (16 per thread): progress(done, total) is called
+        after each with the tiles done, and Ctrl-C stops the run between two calls (nothing
+        is kept)."""
         threads = threads_for(check_workers(workers))
         rd = ffi.new("vpds_tiling_run_desc *", lib.vpds_default_tiling_run_desc())
         rd.threads = min(threads, 256)
-        out = ffi.new("vpds_tiled **")
+        job_out = ffi.new("vpds_tiling_job **")
         msg = ffi.new("char[]", 1024)
-        st = lib.vpds_tiling_run(self._t, rd, out, msg, 1024)
-        cause = take(self._owner, "_callback_error")
-        if st < 0 or cause is not None:
-            if cause is None:
-                _raise(st, ffi.string(msg).decode())
-            raise_failure(st, ffi.string(msg).decode(), cause, "sizing")
+        st = lib.vpds_tiling_job_create(self._t, rd, job_out, msg, 1024)
+        if st < 0:
+            _raise(st, ffi.string(msg).decode())
+        job = ffi.gc(job_out[0], lib.vpds_tiling_job_destroy)
+        step, total = _STEP_TILES_PER_THREAD * max(1, threads), int(self.count)
+        while True:
+            st = lib.vpds_tiling_job_step(job, step, msg, 1024)
+            cause = take(self._owner, "_callback_error")
+            if st < 0 or cause is not None:
+                if cause is None:
+                    _raise(st, ffi.string(msg).decode())
+                raise_failure(st, ffi.string(msg).decode(), cause, "sizing")
+            if progress is not None:
+                progress(int(lib.vpds_tiling_job_tiles_done(job)), total)
+            if st == lib.VPDS_OK:
+                break
+        out = ffi.new("vpds_tiled **")
+        st = lib.vpds_tiling_job_result(job, out, msg, 1024)
+        if st < 0:
+            _raise(st, ffi.string(msg).decode())
         res = ffi.gc(out[0], lib.vpds_tiled_destroy)
         self.last_threads = int(lib.vpds_tiled_threads(res))  # 1 when a callback kept it serial
         n, d = int(lib.vpds_tiled_count(res)), self.spec.d
