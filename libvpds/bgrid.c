@@ -104,6 +104,28 @@ uint64_t vpdsi_bgrid_locate(const vpdsi_bgrid *g, const double *x)
     return idx;
 }
 
+int vpdsi_bgrid_place(vpdsi_bgrid *g, const double *x, const double *box_lo, const double *box_hi,
+                      int32_t i)
+{
+    uint64_t idx = g->origin;
+    int k;
+    for (k = 0; k < g->dim; k++) {
+        double u = floor((x[k] - g->lo[k]) / g->side[k]), n = (double)g->n[k], pad = (double)g->pad;
+        if (x[k] >= box_lo[k] && x[k] <= box_hi[k]) {
+            u = u < 0 ? 0 : u >= n ? n - 1 : u; /* vpdsi_bgrid_locate's cell */
+        } else {
+            /* a point beyond a face lies in a border cell past that face, never inside */
+            if (x[k] < box_lo[k] && u > -1) u = -1;
+            if (x[k] > box_hi[k] && u < n) u = n;
+            if (!(u >= -pad && u < n + pad)) return 0;
+        }
+        idx = (uint64_t)((int64_t)idx + (int64_t)u * (int64_t)g->stride[k]);
+    }
+    if (g->cell[idx] >= 0) return -1;
+    g->cell[idx] = i;
+    return 0;
+}
+
 uint64_t vpdsi_bgrid_index(const vpdsi_bgrid *g, const uint64_t *c)
 {
     uint64_t idx = g->origin;

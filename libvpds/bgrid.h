@@ -25,6 +25,12 @@ int vpdsi_bgrid_setup(vpdsi_bgrid *g, vpdsi_mem *m, int dim, const uint64_t *n, 
 void vpdsi_bgrid_release(vpdsi_bgrid *g, vpdsi_mem *m);
 /* Padded index of the cell holding x. */
 uint64_t vpdsi_bgrid_locate(const vpdsi_bgrid *g, const double *x);
+/* Place sample i at x for the grid's setup: inside [box_lo, box_hi] its cell (as
+ * vpdsi_bgrid_locate), outside in the border when within its width, else nowhere (too far to
+ * meet a query of the box). 0: placed or left out; -1: the cell already holds a sample (closer
+ * than the cell's diagonal: the grid cannot hold this set). */
+int vpdsi_bgrid_place(vpdsi_bgrid *g, const double *x, const double *box_lo, const double *box_hi,
+                      int32_t i);
 /* Padded index of base cell coordinates c. */
 uint64_t vpdsi_bgrid_index(const vpdsi_bgrid *g, const uint64_t *c);
 /* Samples within reach of the cell at padded index at (its own first), appended to out

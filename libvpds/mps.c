@@ -73,6 +73,19 @@ static uint64_t darts_for(uint64_t cells, unsigned level)
     return n < 1 ? 1 : (uint64_t)n;
 }
 
+/* Every sample into the grid just set up: 0, or -1 when the grid cannot hold them (a radius
+ * other than the sizing's, or two in one cell: fixed points closer than the conflict distance).
+ * Fixed points beyond the box (a tile's neighbours) go to its border cells. */
+static int grid_index_all(vpdsi_store *st, const vpdsi_problem *pb)
+{
+    size_t i;
+    for (i = 0; i < st->n; i++)
+        if (st->r[i] != st->sizing.radius ||
+            vpdsi_bgrid_place(&st->grid, st->x + i * (size_t)pb->dim, pb->lo, pb->hi, (int32_t)i))
+            return -1;
+    return 0;
+}
+
 /* The background grid serves a uniform radius in low dimension; the kd-tree everything else.
  * (vpdsi_bgrid_setup releases the grid of an earlier scale; the kd-tree path releases it below.) */
 static vpds_status choose_index(vpdsi_mps *m, const vpdsi_ctx *ctx, int keep_tree)
@@ -81,15 +94,14 @@ static vpds_status choose_index(vpdsi_mps *m, const vpdsi_ctx *ctx, int keep_tre
     vpdsi_store *st = ctx->st;
     vpdsi_run *run = &m->run;
     double reach = run->t * pb->inhibition * st->sizing.radius;
-    size_t i;
     st->grid_mode = 0;
-    if (st->sizing.kind == VPDSI_SIZING_CONSTANT && st->n_fixed == 0 && pb->dim <= 3 &&
-        !pb->two_radii && !pb->any_periodic && !keep_tree &&
+    if (st->sizing.kind == VPDSI_SIZING_CONSTANT && pb->dim <= 3 && !pb->two_radii &&
+        !pb->any_periodic && !keep_tree &&
         vpdsi_bgrid_setup(&st->grid, ctx->mem, pb->dim, run->geom.n0, pb->lo, run->geom.side0, reach) == 0 &&
         vpdsi_mem_reserve(ctx->mem, (void **)&m->cand, &m->cap_cand, st->grid.n_stencil + 1,
-                          sizeof(int32_t)) == 0) {
+                          sizeof(int32_t)) == 0 &&
+        grid_index_all(st, pb) == 0) {
         st->grid_mode = 1;
-        for (i = 0; i < st->n; i++) st->grid.cell[vpdsi_bgrid_locate(&st->grid, st->x + i * (size_t)pb->dim)] = (int32_t)i;
         return VPDS_OK;
     }
     vpdsi_bgrid_release(&st->grid, ctx->mem);

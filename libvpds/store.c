@@ -238,8 +238,9 @@ vpds_status vpdsi_store_add_fixed(vpdsi_store *st, const double *x, const double
     double *radii = NULL;
     vpdsi_kd_samples v;
     vpds_status e;
-    /* fixed points may share cells and carry other radii: the kd-tree takes over, and it must
-     * first hold every sample (it lags after a run on the background grid) */
+    /* fixed points may share cells and carry other radii: the kd-tree takes over (until a run's
+     * set-up finds they fit the background grid), and it must first hold every sample (it lags
+     * after a run on the background grid) */
     if ((e = vpdsi_store_use_tree(st)) != VPDS_OK) return e;
     if ((e = vpdsi_store_reserve(st, n)) != VPDS_OK) return e;
     if (!r) {

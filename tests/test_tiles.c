@@ -556,6 +556,94 @@ static void check_layout(void)
     vpds_tiling_destroy(tg);
 }
 
+/* Run [0,1]^dim at radius r with fixed points fx (nf, at r): its own samples into *own. */
+static size_t run_with_fixed(int dim, double r, uint64_t seed, const double *fx, size_t nf,
+                             double **own)
+{
+    vpds_desc d = vpds_default_desc();
+    vpds_sampler *s = NULL;
+    vpds_status st;
+    size_t n = 0;
+    d.dim = dim;
+    d.radius = r;
+    d.seed = seed;
+    *own = NULL;
+    CHECK(vpds_create(&d, &s) == VPDS_OK);
+    CHECK(vpds_add_points(s, fx, NULL, nf) == VPDS_OK);
+    while ((st = vpds_run(s)) == VPDS_PAUSED) {}
+    CHECK(st == VPDS_OK && vpds_count(s) >= nf);
+    if (st == VPDS_OK && vpds_count(s) >= nf) {
+        n = vpds_count(s) - nf;
+        *own = (double *)malloc((n ? n : 1) * (size_t)dim * sizeof(double));
+        memcpy(*own, vpds_points(s) + nf * (size_t)dim, n * (size_t)dim * sizeof(double));
+    }
+    vpds_destroy(s);
+    return n;
+}
+
+/* Fixed points at the sizing's radius around the box (a tile's neighbours) and inside it sit in
+ * the background grid, those outside in its border cells. The same fixed points with one given
+ * twice (two in one cell: the grid cannot hold them, the kd-tree answers) must give the same
+ * own samples, bit for bit; and those are conflict-free with every fixed point and cover the
+ * box (brute force). */
+static void check_fixed_on_grid(int dim, double r, uint64_t seed, size_t probes)
+{
+    vpds_desc d = vpds_default_desc();
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], ulo[VPDS_MAX_DIM] = {0}, uhi[VPDS_MAX_DIM];
+    double *fx, *all, *rr, *own_grid = NULL, *own_tree = NULL;
+    size_t n, nf = 0, ng, nt, i, inside = SIZE_MAX;
+    vpds_sampler *s = NULL;
+    int k;
+    for (k = 0; k < dim; k++) {
+        lo[k] = -0.2;
+        hi[k] = 1.2;
+        uhi[k] = 1;
+    }
+    d.dim = dim;
+    d.lo = lo;
+    d.hi = hi;
+    d.radius = r;
+    d.seed = seed + 100;
+    CHECK(vpds_create(&d, &s) == VPDS_OK && vpds_run(s) == VPDS_OK);
+    n = vpds_count(s);
+    fx = (double *)malloc((n + 1) * (size_t)dim * sizeof(double));
+    for (i = 0; i < n; i++) { /* the frame around [0,1]^dim, and the strip x0 < 0.25 inside */
+        const double *x = vpds_points(s) + i * (size_t)dim;
+        int out = 0, in_strip = x[0] < 0.25 && x[0] >= 0;
+        for (k = 0; k < dim; k++) out |= x[k] < 0 || x[k] > 1;
+        if (!out && !in_strip) continue;
+        if (!out && inside == SIZE_MAX) inside = nf;
+        memcpy(fx + nf++ * (size_t)dim, x, (size_t)dim * sizeof(double));
+    }
+    vpds_destroy(s);
+    CHECK_MSG(inside != SIZE_MAX && nf > 10, "%dD: %zu fixed points, none inside", dim, nf);
+    if (inside == SIZE_MAX) {
+        free(fx);
+        return;
+    }
+    ng = run_with_fixed(dim, r, seed, fx, nf, &own_grid);
+    memcpy(fx + nf * (size_t)dim, fx + inside * (size_t)dim, (size_t)dim * sizeof(double));
+    nt = run_with_fixed(dim, r, seed, fx, nf + 1, &own_tree);
+    CHECK_MSG(ng > 0 && ng == nt && own_grid && own_tree &&
+                  memcmp(own_grid, own_tree, ng * (size_t)dim * sizeof(double)) == 0,
+              "%dD fixed points: %zu own samples on the grid, %zu on the kd-tree, not the same",
+              dim, ng, nt);
+    all = (double *)malloc((nf + ng + 1) * (size_t)dim * sizeof(double));
+    rr = (double *)malloc((nf + ng + 1) * sizeof(double));
+    memcpy(all, fx, nf * (size_t)dim * sizeof(double));
+    if (own_grid) memcpy(all + nf * (size_t)dim, own_grid, ng * (size_t)dim * sizeof(double));
+    for (i = 0; i < nf + ng; i++) rr[i] = r;
+    CHECK_MSG(conflicts(dim, all, rr, nf + ng, 1, 1.0, ulo, uhi, NULL) == 0,
+              "%dD fixed points: a conflict", dim);
+    CHECK_MSG(uncovered_probes(dim, all, rr, nf + ng, 1, 1.0, ulo, uhi, NULL, const_r, probes) == 0,
+              "%dD fixed points: an uncovered probe", dim);
+    free(fx);
+    free(all);
+    free(rr);
+    free(own_grid);
+    free(own_tree);
+}
+
 int main(void)
 {
     uint64_t t2[2] = {4, 3}, t2p[2] = {4, 2}, t1[1] = {6}, t3[3] = {2, 2, 2};
@@ -571,6 +659,9 @@ int main(void)
     check_tiled(2, t2, NULL, 4, 0, 0.5, probes, "2D two radii");
     check_tiled(1, t1, per1, 2, 0, 1.0, probes, "1D periodic");
     if (!quick()) check_tiled(3, t3, NULL, 4, 0, 1.0, probes / 4, "3D uniform");
+    check_fixed_on_grid(1, 0.01, 1, probes);
+    check_fixed_on_grid(2, 0.03, 2, probes);
+    check_fixed_on_grid(3, 0.09, 3, probes / 4);
     check_on_demand();
     check_windows();
     CHECK_DONE();
