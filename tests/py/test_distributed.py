@@ -114,6 +114,56 @@ def test_tiling_run_on_threads_is_run_tile_over_the_order_and_the_dask_run(tmp_p
         tg.run(workers=0)
 
 
+@pytest.mark.parametrize("case", ["periodic wave", "two radii", "3d"])
+def test_rims_give_the_bytes_of_whole_tiles(case):
+    """A tile's rim (Tiling.rim: its samples within the margin of its faces) is all a later tile
+    takes from it: run_tile given rims makes the bytes it makes given whole tiles, across
+    periodic wraps too, and the rims are a small part of the tiles."""
+    if case == "periodic wave":
+        spec = TilingSpec.make(2, (4, 4), sizing=wave, lipschitz=WAVE_L, radius_max=0.04,
+                               periodic=(True, True), rule="bigger", rng=11)
+    elif case == "two radii":
+        spec = TilingSpec.make(2, (5, 3), u_bounds=(1.0, 0.6), radius=0.02, inhibition=0.5, rng=12)
+    else:
+        spec = TilingSpec.make(3, (3, 4, 2), radius=0.06, periodic=(False, True, True), rng=13)
+    tg = Tiling(spec)
+    whole: dict[int, tuple] = {}
+    rims: dict[int, tuple] = {}
+    kept = total = 0
+    for tile in tg.order():
+        x, r, t = tg.run_tile(tile, {k: whole[k] for k in tg.deps(tile)})
+        xr, rr, tr = tg.run_tile(tile, {k: rims[k] for k in tg.deps(tile)})
+        assert x.tobytes() == xr.tobytes() and r.tobytes() == rr.tobytes() and t.tobytes() == tr.tobytes(), tile
+        whole[tile] = (x, r)
+        rims[tile] = tg.rim(tile, x, r)
+        kept, total = kept + len(rims[tile][0]), total + len(x)
+    assert 0 < kept < 0.8 * total, (kept, total)
+
+
+def test_tile_store_written_directly_reads_back_through_zarr(tmp_path, monkeypatch):
+    """TileStore.write lays out Zarr v3 arrays itself (no zarr round trips): zarr reads them back
+    whole, over several chunks, and an empty tile."""
+    import zarr
+    from vpds import tilestore
+    store = D.TileStore.create(tmp_path / "s.zarr", {"d": 2}, "token", [0, 1, 2])
+    rng = np.random.default_rng(3)
+    x, r, t = rng.random((23, 2)), rng.random(23), rng.random(23)
+    monkeypatch.setattr(tilestore, "_ROWS_PER_CHUNK", 7)
+    store.write(1, x, r, t)
+    store.write(2, np.empty((0, 2)), np.empty(0), np.empty(0))
+    monkeypatch.setattr(tilestore, "_ROWS_PER_CHUNK", 1 << 20)
+    store.write(0, x[::-1], r[::-1], t[::-1])
+    a = zarr.open_array(str(tmp_path / "s.zarr" / "tiles" / "1" / "points"), mode="r")
+    assert a.chunks == (7, 2) and np.array_equal(a[...], x)
+    got = D.TileStore(tmp_path / "s.zarr").read(1)
+    assert all(np.array_equal(u, v) for u, v in zip(got, (x, r, t)))
+    assert np.array_equal(D.TileStore(tmp_path / "s.zarr").read(0)[0], x[::-1])
+    empty = D.TileStore(tmp_path / "s.zarr").read(2)
+    assert empty[0].shape == (0, 2) and empty[1].shape == (0,)
+    assert [store.tile_count(k) for k in range(3)] == [23, 23, 0] and not store.missing()
+    assert zarr.open_group(str(tmp_path / "s.zarr" / "tiles" / "1"), mode="r").attrs["phase"] == 1
+
+
 def test_refused_tilings_name_the_argument(tmp_path):
     with pytest.raises(vpds.VpdsValueError, match=r"tiles\[0\] = 3: a periodic axis needs an even"):
         TilingSpec.make(2, (3, 4), radius=0.02, periodic=(True, False))

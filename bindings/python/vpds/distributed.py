@@ -45,19 +45,26 @@ def _tiling_for(spec: TilingSpec) -> Tiling:
     return t
 
 
-def run_tile(spec: TilingSpec, path: str, tile: int, *done: Any) -> int:
-    """One tile: read its dependencies from the store, run it, write it, mark it complete.
-    Idempotent: a tile already complete is left as it is (a retried or resumed task)."""
+Rim = tuple[np.ndarray, np.ndarray]
+
+
+def run_tile(spec: TilingSpec, path: str, tile: int, dep_tiles: Sequence[int] = (),
+             *dep_rims: Rim) -> Rim:
+    """One tile: run it from its dependencies' samples, write it, mark it complete, and return
+    its rim (Tiling.rim: what the tiles after it need). Dependencies in dep_tiles come as their
+    rims (the results of their tasks, handed over by Dask), the others are read from the store
+    (tiles of a resumed run). Idempotent: a tile already complete is read, not run again."""
     store = _STORES.get(path)
     if store is None:
         store = _STORES[path] = TileStore(path, mode="r+")
-    if store.complete(tile):
-        return store.tile_count(tile)
     tiling = _tiling_for(spec)
-    deps = {k: store.read_points(k) for k in tiling.deps(tile)}
+    if store.complete(tile):
+        return tiling.rim(tile, *store.read_points(tile))
+    given = dict(zip(dep_tiles, dep_rims))
+    deps = {k: given[k] if k in given else store.read_points(k) for k in tiling.deps(tile)}
     x, r, t = tiling.run_tile(tile, deps)
     store.write(tile, x, r, t)
-    return len(x)
+    return tiling.rim(tile, x, r)
 
 
 def _open_store(store: Union[str, Path], spec: TilingSpec, tiling: Tiling, overwrite: bool) -> TileStore:
@@ -121,7 +128,7 @@ def sample(store: Union[str, Path], d: int, tiles: Union[int, Sequence[int]], *,
             client = Client(own_cluster)
     own_client = own_cluster is not None or address is not None
     bar = None
-    futures: dict[int, Future[int]] = {}
+    futures: dict[int, Future[Rim]] = {}
     try:
         if progress:
             try:
@@ -133,19 +140,32 @@ def sample(store: Union[str, Path], d: int, tiles: Union[int, Sequence[int]], *,
         spec_f = client.scatter(spec, broadcast=True, hash=False)
         nonce = uuid.uuid4().hex[:8]
         pending = set(todo)
+        waiting: dict[int, int] = {}  # per submitted tile: its submitted dependents not yet done
         for tile in tiling.order():
             if tile not in pending:
                 continue
-            deps = [futures[k] for k in tiling.deps(tile) if k in futures]
-            futures[tile] = client.submit(run_tile, spec_f, str(store), tile, *deps,
+            deps = [k for k in tiling.deps(tile) if k in futures]
+            for k in deps:
+                waiting[k] += 1
+            waiting[tile] = 0
+            futures[tile] = client.submit(run_tile, spec_f, str(store), tile, deps,
+                                          *[futures[k] for k in deps],
                                           key=f"vpds-tile-{spec.token[:8]}-{nonce}-{tile}", pure=False)
         back = {f.key: k for k, f in futures.items()}
         for fut in as_completed(list(futures.values())):
-            n = fut.result()  # raises the task's error (C message included)
+            if fut.status != "finished":
+                fut.result()  # raises the task's error (C message included)
+            tile = back[fut.key]
+            # a tile's rim stays in the workers' memory only while a tile after it still runs
+            for k in [tile] + [k for k in tiling.deps(tile) if k in waiting]:
+                if k != tile:
+                    waiting[k] -= 1
+                if waiting[k] == 0 and futures[k].done():
+                    del futures[k], waiting[k]
             if bar is not None:
                 bar.update(1)
             if on_tile is not None:
-                on_tile(back[fut.key], n)
+                on_tile(tile, out.tile_count(tile))
     except BaseException:
         for f in futures.values():
             f.cancel()
@@ -167,9 +187,12 @@ def run_local(store: Union[str, Path], spec: TilingSpec, order: Optional[Iterabl
     tiling = Tiling(spec)
     out = _open_store(store, spec, tiling, overwrite)
     _TILINGS[spec.token] = tiling
+    rims: dict[int, Rim] = {}  # the tiles run here: what later tiles take from them
     for tile in (tiling.order() if order is None else order):
-        missing = [k for k in tiling.deps(tile) if not out.complete(k)]
+        deps = tiling.deps(tile)
+        missing = [k for k in deps if k not in rims and not out.complete(k)]
         if missing:
             raise ValueError(f"tile {tile} (phase {tiling.phase(tile)}) needs tiles {missing} first")
-        run_tile(spec, str(store), tile)
+        given = [k for k in deps if k in rims]
+        rims[tile] = run_tile(spec, str(store), tile, given, *[rims[k] for k in given])
     return out

@@ -262,6 +262,21 @@ class Tiling:
             _raise(st, f"tile {tile}: the cone is too large to list")
         return [int(buf[i]) for i in range(n[0])]
 
+    def rim(self, tile: int, x: npt.ArrayLike, r: npt.ArrayLike
+            ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """The samples (x (n, d), r (n,)) of this tile's own samples that lie within the margin of
+        its box's faces, in their order: all that a later tile's run takes from it (a sample
+        within the margin of a neighbour's box is within it of the face between them, across a
+        periodic wrap too), so run_tile given rims makes the bytes it makes given whole tiles."""
+        x = np.asarray(x, dtype=np.float64).reshape(-1, self.spec.d)
+        r = np.asarray(r, dtype=np.float64).reshape(-1)
+        lo, hi = self.box(tile)
+        # a wider band than the C filter's, so that no rounding of a wrap drops one it keeps
+        slack = self.margin * 1e-6 + 1e-9 * float(np.max(np.abs(np.concatenate([lo, hi]))) + 1.0)
+        gap = np.minimum(x - lo, hi - x).min(axis=1, initial=np.inf) if len(x) else np.empty(0)
+        keep = gap <= self.margin + slack
+        return x[keep], r[keep]
+
     def order(self) -> list[int]:
         """All tiles in an order that can run one after another: by phase, then index."""
         return sorted(range(self.count), key=lambda k: (self.phase(k), k))
