@@ -4,6 +4,7 @@ same box in this process (vpds.PoissonDisk) as the reference.
 
     python bench/tiled.py            # about 2 minutes on a 2-core machine
     python bench/tiled.py --quick    # a few seconds per row
+    python bench/tiled.py --total 10000000   # the table at 10^7 samples (about 10 minutes)
     python bench/tiled.py --largest 100000000 --tiles 64   # one big run to disk
 
 Wall clock, one run per row; the cluster is started before the clock (its start-up, about
@@ -39,13 +40,31 @@ def dir_mb(path: Path) -> float:
     return sum(f.stat().st_size for f in path.rglob("*") if f.is_file()) / 2**20
 
 
-def run(client, path: Path, side: float, tiles: int, radius: float) -> tuple[int, float]:
+def run(client, path: Path, side: float, tiles, radius: float) -> tuple[int, float, tuple[int, ...]]:
+    """One Dask run (tiles: per axis, or None for the default layout): points, seconds, tiles."""
     from vpds import distributed
     t0 = time.perf_counter()
-    store = distributed.sample(path, 2, (tiles, tiles), u_bounds=(side, side), radius=radius,
+    store = distributed.sample(path, 2, tiles, u_bounds=(side, side), radius=radius,
                                rng=1, client=client, progress=False, overwrite=True)
     seconds = time.perf_counter() - t0
-    return store.total, seconds
+    return store.total, seconds, tuple(store.params["tiles"])
+
+
+def warm_up() -> None:
+    """A worker's imports (numpy, the C extension, zarr), done before the clock."""
+    import numcodecs  # noqa: F401
+    import zarr  # noqa: F401
+    import vpds.distributed  # noqa: F401
+
+
+def tile_work(side: float, tiles: tuple[int, ...], radius: float) -> float:
+    """Seconds of the same tiles run back to back in this process by the C library (one
+    thread, no Dask, no Zarr): the tiles' own work, seams included."""
+    from vpds.tiling import Tiling, TilingSpec
+    tiling = Tiling(TilingSpec.make(2, tiles, u_bounds=(side, side), radius=radius, rng=1))
+    t0 = time.perf_counter()
+    tiling.run(workers=1)
+    return time.perf_counter() - t0
 
 
 def main() -> int:
@@ -54,6 +73,7 @@ def main() -> int:
     ap.add_argument("--largest", type=int, help="one run of about this many points (2 workers)")
     ap.add_argument("--tiles", type=int, default=32, help="tiles per axis for --largest")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--total", type=int, help="samples of the table's runs (default 2e6; --quick 3e5)")
     ap.add_argument("--dir", help="where the stores go (default: a temporary directory)")
     args = ap.parse_args()
     from distributed import Client, LocalCluster
@@ -73,7 +93,7 @@ def main() -> int:
                                dashboard_address=":0")
         client = Client(cluster)
         start = time.perf_counter() - t0
-        n, s = run(client, base / "largest.zarr", side, args.tiles, radius)
+        n, s, _ = run(client, base / "largest.zarr", side, args.tiles, radius)
         rss = max(client.run(peak_rss_mb).values())
         print(f"largest run: {n:,} points, box {side:.0f} x {side:.0f}, {args.tiles}^2 tiles, "
               f"{args.workers} workers: {s:.1f} s ({n / s:,.0f} samples/s; cluster start {start:.1f} s), "
@@ -84,7 +104,7 @@ def main() -> int:
             shutil.rmtree(base)
         return 0
 
-    total = 300_000 if args.quick else 2_000_000
+    total = args.total or (300_000 if args.quick else 2_000_000)
     side = float(np.sqrt(total / density))
     # the reference: one run over the whole box in this process
     t0 = time.perf_counter()
@@ -95,9 +115,10 @@ def main() -> int:
           f"{len(x) / one:,.0f} samples/s, process peak {peak_rss_mb():.0f} MB")
     del x
 
-    print("\n| workers | tiles | samples | seconds | samples/s | vs one run | peak MB per worker |")
-    print("|---|---|---|---|---|---|---|")
-    rows = [(1, 8), (2, 8)] + [(2, t) for t in ((4, 16) if args.quick else (4, 16, 32))]
+    print("\n| workers | tiles | samples | seconds | samples/s | vs one run | tiles' own work | "
+          "overhead and idle per tile | peak MB per worker |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    rows = [(1, None), (2, None), (2, 8)] + ([] if args.quick else [(2, 16)])
     clusters: dict = {}
     for workers, tiles in rows:
         if workers not in clusters:
@@ -110,9 +131,16 @@ def main() -> int:
             clusters[workers] = (Client(cl), cl)
         client = clusters[workers][0]
         client.restart()  # fresh processes: the peak memory is this row's
-        n, s = run(client, base / f"w{workers}t{tiles}.zarr", side, tiles, radius)
+        client.run(warm_up)  # their imports, as the cluster's start, are not the run's
+        n, s, layout = run(client, base / f"w{workers}t{tiles}.zarr", side, tiles, radius)
         rss = max(client.run(peak_rss_mb).values())
-        print(f"| {workers} | {tiles}x{tiles} | {n:,} | {s:.2f} | {n / s:,.0f} | {(n / s) / rate_one:.2f}x "
+        work = tile_work(side, layout, radius)
+        count = int(np.prod(layout))
+        name = f"{layout[0]}x{layout[1]}" + (" (default)" if tiles is None else "")
+        # what the workers' time held beyond the tiles' own work: Dask, Zarr, rims, waiting
+        per_tile_ms = (s * workers - work) / count * 1e3
+        print(f"| {workers} | {name} | {n:,} | {s:.2f} | {n / s:,.0f} | {(n / s) / rate_one:.2f}x "
+              f"| {work:.2f} s | {per_tile_ms:.0f} ms ({per_tile_ms / (work / count * 1e3):.0%} of a tile's work) "
               f"| {rss:.0f} |", flush=True)
     for c, cl in clusters.values():
         c.close()

@@ -164,6 +164,30 @@ def test_tile_store_written_directly_reads_back_through_zarr(tmp_path, monkeypat
     assert zarr.open_group(str(tmp_path / "s.zarr" / "tiles" / "1"), mode="r").attrs["phase"] == 1
 
 
+def test_default_tiles_follow_the_box_and_the_radii():
+    """tiles=None: about TILE_SAMPLES estimated samples a tile (at least MIN_TILES tiles while
+    each holds MIN_TILE_SAMPLES), near-cubic tiles, even counts on periodic axes, thinned until
+    the C tiling accepts them; the same arguments give the same tiles."""
+    from vpds import tiling as T
+    big = TilingSpec.make(2, None, radius=0.0003, rng=1)
+    n = T.estimated_samples(big)
+    assert n > 20 * T.TILE_SAMPLES
+    assert 0.5 * T.TILE_SAMPLES < n / np.prod(big.tiles) < 2 * T.TILE_SAMPLES, big.tiles
+    assert big.tiles[0] == big.tiles[1] and TilingSpec.make(2, None, radius=0.0003, rng=9).tiles == big.tiles
+    mid = TilingSpec.make(2, None, radius=0.001)  # 7e5 samples: the floor of MIN_TILES tiles
+    assert np.prod(mid.tiles) >= T.MIN_TILES and mid.tiles[0] == mid.tiles[1]
+    small = TilingSpec.make(2, None, radius=0.05)
+    assert small.tiles == (1, 1)
+    long = TilingSpec.make(2, None, radius=0.001, u_bounds=(1.0, 40.0))
+    assert long.tiles[1] > 20 * long.tiles[0], long.tiles
+    per = TilingSpec.make(3, None, radius=0.004, periodic=(True, False, True))
+    assert per.tiles[0] % 2 == 0 and per.tiles[2] % 2 == 0 and min(per.tiles) >= 2
+    thin = TilingSpec.make(2, None, radius=0.0004, u_bounds=(1.0, 0.001))  # one row: the tiles as thick as allowed
+    assert thin.tiles[1] == 1 and thin.tiles[0] > 1
+    with pytest.raises(vpds.VpdsValueError, match=r"periodic\[1\]: the side 0.5"):  # the C message
+        TilingSpec.make(2, None, radius=0.3, u_bounds=(1.0, 0.5), periodic=(False, True))
+
+
 def test_refused_tilings_name_the_argument(tmp_path):
     with pytest.raises(vpds.VpdsValueError, match=r"tiles\[0\] = 3: a periodic axis needs an even"):
         TilingSpec.make(2, (3, 4), radius=0.02, periodic=(True, False))
@@ -360,6 +384,14 @@ def test_cli_tiles(tmp_path, cluster, capsys):
                          text=True)
     assert res.returncode == 0 and "all guarantees hold" in res.stdout, res.stdout + res.stderr
     assert "run: tiles" in res.stdout and "radius 0.03" in res.stdout
+    # --tiles auto: the layout of tiles=None, resumed as the same run
+    auto = ["sample", "--tiles", "auto", "--radius", "0.004", "-o", str(tmp_path / "auto.zarr"),
+            "--address", client.scheduler.address, "--no-progress"]
+    tiles = TilingSpec.make(2, None, radius=0.004).tiles
+    assert main(auto) == 0 and f"over {int(np.prod(tiles))} tiles {tiles}" in capsys.readouterr().out
+    assert main(auto) == 0 and f"tiles {tiles}" in capsys.readouterr().out
+    assert main(["sample", "--tiles", "many", "-o", str(tmp_path / "m.zarr")]) == 2
+    assert "--tiles 'many': expected tile counts separated by commas, or auto" in capsys.readouterr().err
 
 
 def test_sizing_file_with_array_bounds(tmp_path):

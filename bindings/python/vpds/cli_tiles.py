@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING, Callable, Optional
 
 import numpy as np
 
@@ -18,7 +18,8 @@ if TYPE_CHECKING:  # for the annotation: vpds.tiling loads the C extension
 def add_tile_arguments(s: argparse.ArgumentParser, plain: Callable[[argparse.Namespace], int]) -> None:
     """The tiled form's options on the `sample` parser; runs `plain` when --tiles is absent."""
     g = s.add_argument_group("tiled sampling (vpds.distributed, Dask, Zarr)")
-    g.add_argument("--tiles", help="tiles per axis: one count for every axis, or comma-separated; "
+    g.add_argument("--tiles", help="tiles per axis: one count for every axis, or comma-separated, "
+                   "or 'auto' (tiles of about 200,000 samples, from the box and the radii); "
                    "-o must then name a .zarr store (resumed if it holds the same run)")
     g.add_argument("--workers", type=int, help="LocalCluster worker processes (default: the cores)")
     g.add_argument("--address", help="a Dask scheduler's address instead of a LocalCluster")
@@ -38,14 +39,17 @@ def cmd_sample_tiles(args: argparse.Namespace) -> int:
         if getattr(args, flag):
             raise UsageError(f"--{flag} is not available with --tiles (--tiles runs the tiles on "
                              "Dask, --workers processes; --threads runs them in this process)")
-    try:
-        counts = [int(v) for v in args.tiles.split(",")]
-    except ValueError:
-        raise UsageError(f"--tiles {args.tiles!r}: expected tile counts separated by commas") from None
-    if len(counts) == 1:
-        counts = counts * dim
-    if len(counts) != dim:
-        raise UsageError(f"--tiles has {len(counts)} counts for --dim {dim}")
+    counts: Optional[list[int]] = None
+    if args.tiles != "auto":
+        try:
+            counts = [int(v) for v in args.tiles.split(",")]
+        except ValueError:
+            raise UsageError(f"--tiles {args.tiles!r}: expected tile counts separated by commas, "
+                             "or auto") from None
+        if len(counts) == 1:
+            counts = counts * dim
+        if len(counts) != dim:
+            raise UsageError(f"--tiles has {len(counts)} counts for --dim {dim}")
     lo = _floats(args.lo, dim, 0.0, "--lo")
     hi = _floats(args.hi, dim, 1.0, "--hi")
     sizing: SizingArg = None
@@ -84,6 +88,7 @@ def cmd_sample_tiles(args: argparse.Namespace) -> int:
         "sizing": args.sizing, "sizing_exr": args.sizing_exr, "rule": args.rule,
         "inhibition": args.inhibition, "coverage": args.coverage, "mode": "tiles",
         "complete": True, "lipschitz": args.lipschitz, "seed": args.seed}
+    counts = list(store.params["tiles"])
     print(f"{total} samples in {dim}D over {int(np.prod(counts))} tiles {tuple(counts)} "
           f"(rule {args.rule}, seed {args.seed}) in {seconds:.3f} s; all tiles complete")
     print(f"wrote {args.output} (read it back with vpds.distributed.TileStore)")

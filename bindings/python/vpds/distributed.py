@@ -76,16 +76,16 @@ def _open_store(store: Union[str, Path], spec: TilingSpec, tiling: Tiling, overw
                             [tiling.phase(k) for k in range(tiling.count)])
 
 
-def _spec(d: int, tiles: Union[int, Sequence[int]], **kw: Any) -> TilingSpec:
+def _spec(d: int, tiles: Union[int, Sequence[int], None], **kw: Any) -> TilingSpec:
     if isinstance(kw.get("sizing"), (str, os.PathLike)):
         # `is None`, not `or`: bounds given as numpy arrays have no truth value
         lo, hi = kw.get("l_bounds"), kw.get("u_bounds")
         kw["sizing"] = GridSource(kw["sizing"], [0.0] * d if lo is None else lo,
                                   [1.0] * d if hi is None else hi)
-    return TilingSpec.make(d, tiles if not isinstance(tiles, int) else [tiles] * d, **kw)
+    return TilingSpec.make(d, [tiles] * d if isinstance(tiles, int) else tiles, **kw)
 
 
-def sample(store: Union[str, Path], d: int, tiles: Union[int, Sequence[int]], *,
+def sample(store: Union[str, Path], d: int, tiles: Union[int, Sequence[int], None] = None, *,
            l_bounds: Optional[BoundsLike] = None, u_bounds: Optional[BoundsLike] = None,
            radius: float = 0.05, sizing: Union[SizingArg, str, os.PathLike[str]] = None,
            lipschitz: Optional[float] = None, rule: str = "smaller", inhibition: float = 1.0,
@@ -97,7 +97,9 @@ def sample(store: Union[str, Path], d: int, tiles: Union[int, Sequence[int]], *,
            on_tile: Optional[Callable[[int, int], None]] = None) -> TileStore:
     """Sample the box [l_bounds, u_bounds] (each of shape (d,); default 0 and 1) as `tiles` tiles
     per axis into the Zarr store at `store`, on Dask, and return the store (a reader that streams
-    the tiles back).
+    the tiles back). tiles=None: tiles of about 200,000 samples, from the box and the radii
+    alone (vpds.tiling.default_tiles), never from the cluster, so the bytes stay those of the
+    arguments on any cluster and on a resume.
 
     The sampling arguments are PoissonDisk's (`sizing`: a float, a numpy grid in memory, a
     `GridSource` or a path to a .npy / .zarr / .exr grid read one window per tile, or a

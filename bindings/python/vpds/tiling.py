@@ -9,7 +9,7 @@ from __future__ import annotations
 import hashlib
 import math
 import numbers
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Callable, Mapping, Optional, Sequence, Union
 
 import numpy as np
@@ -17,7 +17,7 @@ import numpy.typing as npt
 
 from ._callbacks import raise_failure, take
 from ._core import RULES, SizingGrid
-from ._errors import _raise, created
+from ._errors import VpdsValueError, _raise, created
 from ._scipy_compat import _seed_from
 from ._tiled import check_workers, threads_for
 from ._typing import BoundsLike, RngLike, SizingFunction
@@ -62,20 +62,21 @@ class TilingSpec:
     _token: str = field(default="", repr=False)
 
     @classmethod
-    def make(cls, d: int, tiles: Sequence[int], *, l_bounds: Optional[BoundsLike] = None,
+    def make(cls, d: int, tiles: Optional[Sequence[int]], *, l_bounds: Optional[BoundsLike] = None,
              u_bounds: Optional[BoundsLike] = None, radius: float = 0.05,
              sizing: SizingArg = None, lipschitz: Optional[float] = None, rule: str = "smaller",
              inhibition: float = 1.0, coverage: float = 1.0,
              periodic: Optional[Sequence[bool]] = None, weighted: bool = False,
              radius_min: Optional[float] = None, radius_max: Optional[float] = None,
              rng: RngLike = 0, scale: float = 1.0) -> "TilingSpec":
-        """Checked arguments (the C library checks the rest, with its messages)."""
+        """Checked arguments (the C library checks the rest, with its messages). tiles=None:
+        the layout default_tiles derives from the box and the radii."""
         if not isinstance(d, (numbers.Integral, np.integer)) or isinstance(d, bool):
             raise TypeError(f"d = {d!r}: must be an int")
         d = int(d)
         if rule not in RULES:
             raise ValueError(f"rule = {rule!r}: must be one of {sorted(RULES)}")
-        tiles_t = tuple(int(v) for v in np.atleast_1d(tiles))
+        tiles_t = (1,) * d if tiles is None else tuple(int(v) for v in np.atleast_1d(tiles))
         if len(tiles_t) == 1 and d > 1:
             tiles_t = tiles_t * d
         if len(tiles_t) != d:
@@ -105,6 +106,8 @@ class TilingSpec:
                    rule, float(inhibition), float(coverage), per, bool(weighted),
                    None if radius_min is None else float(radius_min),
                    None if radius_max is None else float(radius_max), _seed_from(rng), float(scale))
+        if tiles is None:
+            spec.tiles = default_tiles(spec)
         spec._token = spec._compute_token()
         Tiling(spec)  # refuse a bad tiling here, with the C message, before any work
         return spec
@@ -138,6 +141,55 @@ class TilingSpec:
                 "coverage": self.coverage, "periodic": None if self.periodic is None else list(self.periodic),
                 "weighted": self.weighted, "radius_min": self.radius_min,
                 "radius_max": self.radius_max, "seed": self.seed, "scale": self.scale}
+
+
+#: tiles=None: tiles of about this many samples (a second or so of work each: the per-tile cost
+#: of a Dask task, its Zarr write and its neighbours' rims, about 10 ms, stays near 1%) ...
+TILE_SAMPLES = 200_000
+#: ... and at least MIN_TILES of them while each still holds MIN_TILE_SAMPLES, so that the
+#: workers of a machine or two share even a smaller run
+MIN_TILES, MIN_TILE_SAMPLES = 16, 20_000
+
+
+def estimated_samples(spec: TilingSpec) -> float:
+    """Samples of the whole run (vpds_estimate on the whole box, within about 2x). A sizing
+    read per tile (GridSource) is estimated at the geometric mean of its smallest and largest
+    radius: the grid is not read whole."""
+    tg = Tiling(replace(spec, tiles=tuple(2 if spec.periodic and spec.periodic[k] else 1
+                                          for k in range(spec.d))))
+    if isinstance(spec.sizing, GridSource) and spec.radius_min and spec.radius_max:
+        tg._desc.radius = math.sqrt(spec.radius_min * spec.radius_max)  # make() read them
+    sampler = created(lib.vpds_validate, lib.vpds_create, lib.vpds_destroy, "vpds_sampler", tg._desc)
+    out = ffi.new("vpds_run_estimate *")
+    st = lib.vpds_estimate(sampler, spec.scale, out)
+    if st != lib.VPDS_OK:
+        _raise(st, ffi.string(lib.vpds_last_error(sampler)).decode())
+    return float(out.samples)
+
+
+def default_tiles(spec: TilingSpec) -> tuple[int, ...]:
+    """The tile counts of tiles=None: from the box and the radii alone (through the estimate),
+    never from the workers, so the same arguments give the same tiles, hence the same bytes,
+    on any cluster and on a resume. Tiles near-cubic, of about TILE_SAMPLES samples (at least
+    MIN_TILES tiles while each keeps MIN_TILE_SAMPLES), even on periodic axes, and thinned
+    until the C tiling accepts them (a tile is no thinner than the margin)."""
+    n = estimated_samples(spec)
+    want = max(math.ceil(n / TILE_SAMPLES), min(MIN_TILES, math.floor(n / MIN_TILE_SAMPLES)), 1)
+    ext = [hi - lo for lo, hi in zip(spec.l_bounds, spec.u_bounds)]
+    side = (float(np.prod(ext)) / want) ** (1.0 / spec.d)
+    per = spec.periodic or (False,) * spec.d
+    counts = [max(1, round(e / side)) for e in ext]
+    counts = [c + (c % 2) if per[k] else c for k, c in enumerate(counts)]
+    while True:
+        try:
+            Tiling(replace(spec, tiles=tuple(counts)))
+            return tuple(counts)
+        except VpdsValueError:
+            k = int(np.argmax([c / e for c, e in zip(counts, ext)]))  # the thinnest tiles
+            floor = 2 if per[k] else 1
+            if counts[k] <= floor:
+                raise
+            counts[k] = max(floor, counts[k] - (2 if per[k] else 1))
 
 
 class _CallbackOwner:
