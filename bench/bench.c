@@ -5,6 +5,7 @@
  *          rule bigger, at algorithm_version VERSION: a fuzz input's workload)
  *        | annulus RADIUS (a domain) | stream DIM RADIUS N STEPS (prints one line per N/STEPS samples: the cost along n)
  *        | threads DIM RADIUS TILES THREADS (vpds_tiling_run of TILES per axis on THREADS threads)
+ *        | rampthreads RULE TILES_X TILES_Y THREADS (the ramp's box tiled so, its sizing thread-safe)
  *        | tilestats DIM RADIUS TILES (the speed-up model's inputs: one run, each phase's tile work
  *          and largest tile, and the bounds it gives for 2, 16, 64, 1024 workers)
  *        | mesh square|sphere RADIUS (the unit square as two triangles, or the unit sphere as an
@@ -83,20 +84,18 @@ static int stream(vpds_desc *d, size_t n, size_t steps)
 }
 
 /* A whole tiling (tiles per axis) on some threads: its wall time against one run's. */
-static int tiled(vpds_desc *d, uint64_t per_axis, int threads)
+static int tiled(vpds_desc *d, const uint64_t *tiles, int threads)
 {
     vpds_tiling_desc td = vpds_default_tiling_desc();
     vpds_tiling_run_desc rd = vpds_default_tiling_run_desc();
-    uint64_t tiles[VPDS_MAX_DIM];
     vpds_tiling *tg;
     vpds_tiled *out;
     char msg[512];
     double t0;
-    int k;
-    for (k = 0; k < d->dim; k++) tiles[k] = per_axis;
     td.sampler = d;
     td.tiles = tiles;
     rd.threads = threads;
+    rd.callbacks_thread_safe = 1; /* the bench's sizing functions are pure */
     if (vpds_tiling_create(&td, &tg) != VPDS_OK) return 1;
     t0 = now();
     if (vpds_tiling_run(tg, &rd, &out, msg, sizeof msg) != VPDS_OK) {
@@ -329,7 +328,11 @@ int main(int argc, char **argv)
     if (argc >= 6 && !strcmp(argv[1], "threads")) {
         d.dim = atoi(argv[2]);
         d.radius = atof(argv[3]);
-        return tiled(&d, (uint64_t)atoi(argv[4]), atoi(argv[5]));
+        uint64_t tiles[VPDS_MAX_DIM];
+        int k;
+        d.dim = d.dim < 1 ? 1 : d.dim > VPDS_MAX_DIM ? VPDS_MAX_DIM : d.dim;
+        for (k = 0; k < d.dim; k++) tiles[k] = (uint64_t)atoi(argv[4]);
+        return tiled(&d, tiles, atoi(argv[5]));
     }
     if (argc >= 5 && !strcmp(argv[1], "tilestats")) {
         d.dim = atoi(argv[2]);
@@ -346,7 +349,7 @@ int main(int argc, char **argv)
         d.radius = atof(argv[3]);
         return stream(&d, (size_t)atof(argv[4]), (size_t)atoi(argv[5]));
     }
-    if (argc >= 3 && !strcmp(argv[1], "ramp")) {
+    if (argc >= 3 && (!strcmp(argv[1], "ramp") || (argc >= 6 && !strcmp(argv[1], "rampthreads")))) {
         /* the paper's Figure 1 ramp on a box 400 times taller: about a million samples */
         double lo[2] = {0, 0}, hi[2] = {1, 400};
         d.lo = lo;
@@ -355,6 +358,13 @@ int main(int argc, char **argv)
         d.lipschitz = 0.3;
         d.rule = !strcmp(argv[2], "prior") ? VPDS_RULE_PRIOR : !strcmp(argv[2], "current") ? VPDS_RULE_CURRENT
                  : !strcmp(argv[2], "bigger") ? VPDS_RULE_BIGGER : VPDS_RULE_SMALLER;
+        if (!strcmp(argv[1], "rampthreads")) {
+            uint64_t tiles[2];
+            d.radius_max = 0.301;
+            tiles[0] = (uint64_t)atoi(argv[3]);
+            tiles[1] = (uint64_t)atoi(argv[4]);
+            return tiled(&d, tiles, atoi(argv[5]));
+        }
         return run(argv[2], &d);
     }
     if (argc >= 4 && !strcmp(argv[1], "mesh")) {
@@ -387,7 +397,7 @@ int main(int argc, char **argv)
         free(x);
         return 0;
     }
-    fprintf(stderr, "usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION | ramp RULE"
+    fprintf(stderr, "usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION | ramp RULE | rampthreads RULE TX TY THREADS"
                     " | tworamp3 VERSION | floor N DIM | stream DIM RADIUS N STEPS | mesh square|sphere RADIUS | meshstream N | meshfile FILE RADIUS\n");
     return 2;
 }
