@@ -170,6 +170,12 @@ def thread_rows(row) -> None:
             tn, ts, _ = vpds("threads", dim, r, per_axis, threads)
             row(f"libvpds {dim}D uniform, {per_axis}^{dim} tiles, {threads} thread(s)", tn, ts,
                 note=f"speed-up over one vpds_run ({n:,d} samples in {sec:.2f} s): {sec / ts:.2f}x")
+    if not QUICK:  # Figure 1's ramp on the 1 x 400 box, 1 x 20 tiles (tiles="auto"'s sides)
+        n, sec, _ = vpds("ramp", "smaller")
+        for threads in (1, 2):
+            tn, ts, _ = vpds("rampthreads", "smaller", 1, 20, threads)
+            row(f"libvpds ramp 1x400 (smaller), 1x20 tiles, {threads} thread(s)", tn, ts,
+                note=f"speed-up over one vpds_run ({n:,d} samples in {sec:.2f} s): {sec / ts:.2f}x")
 
 
 def stream_rows() -> None:
