@@ -490,21 +490,40 @@ static uint64_t near_key(const vpdsi_lattice *g, const uint64_t *base, uint64_t 
     return key + 1;
 }
 
+/* Half the diagonal of [lo, hi], doubled: the farthest two of its points lie apart. */
+static double box_diagonal(int d, const double *lo, const double *hi)
+{
+    double s = 0;
+    int k;
+    for (k = 0; k < d; k++) s += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    return sqrt(s);
+}
+
+/* The bound of r a list searched for the box [lo, hi] holds for: the sizing's radius, or r_hi
+ * of a cell inside it grown by L across the box (a cell found above it searches again). */
+static double near_bound(const vpdsi_store *st, double r_hi, int d, const double *lo, const double *hi)
+{
+    if (st->sizing.kind == VPDSI_SIZING_CONSTANT) return st->sizing.radius;
+    return r_hi + st->sizing.lipschitz * box_diagonal(d, lo, hi);
+}
+
 /* The samples near the base cell holding c (the kd-tree path with one radius), searched once
  * while the cells of a strip of base cells are swept one after another: m->strip holds those
- * near the strip; below level 0, m->base those of them near the base cell. Returns the list. */
+ * near the strip; below level 0, m->base those of them near the base cell. Each holds for
+ * cells of r <= r_bound (vpdsi_kd_near_box), so a variable radius uses them too; the list
+ * gather then returns the tree's samples in the tree's order: the same bytes. */
 static const vpdsi_near_list *near_lists(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t *c,
-                                         unsigned level, double scale)
+                                         unsigned level, double scale, double r_hi)
 {
     const vpdsi_store *st = ctx->st;
     const vpdsi_lattice *g = &m->run.geom;
     vpdsi_kd_samples view = vpdsi_store_view(st);
     uint64_t base[VPDS_MAX_DIM], key, last;
-    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], x[VPDS_MAX_DIM];
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], x[VPDS_MAX_DIM], rb;
     int k;
     for (k = 0; k < g->dim; k++) base[k] = c[k] >> level;
     if (m->strip.store_n != st->n) m->strip.key = m->base.key = 0;
-    if ((key = near_key(g, base, NEAR_STRIP)) != m->strip.key) {
+    if ((key = near_key(g, base, NEAR_STRIP)) != m->strip.key || r_hi > m->strip.r_bound) {
         uint64_t first = base[0] - base[0] % NEAR_STRIP, b0 = base[0];
         last = first + NEAR_STRIP - 1 < g->n0[0] ? first + NEAR_STRIP - 1 : g->n0[0] - 1;
         base[0] = first;
@@ -513,7 +532,8 @@ static const vpdsi_near_list *near_lists(vpdsi_mps *m, const vpdsi_ctx *ctx, con
         vpdsi_lattice_box(g, 0, base, x, hi);
         base[0] = b0;
         m->strip.n = 0;
-        if (vpdsi_kd_near_box(&st->tree, &view, lo, hi, st->sizing.radius, scale, 0.0, SIZE_MAX,
+        rb = near_bound(st, r_hi, g->dim, lo, hi);
+        if (vpdsi_kd_near_box(&st->tree, &view, lo, hi, rb, scale, 0.0, SIZE_MAX,
                               ctx->mem, &m->strip.idx, &m->strip.n, &m->strip.cap) < 0 ||
             vpdsi_mem_reserve(ctx->mem, (void **)&m->base.idx, &m->base.cap, m->strip.n,
                               sizeof(int32_t)) ||
@@ -522,14 +542,18 @@ static const vpdsi_near_list *near_lists(vpdsi_mps *m, const vpdsi_ctx *ctx, con
             return NULL;
         m->strip.key = key;
         m->strip.store_n = st->n;
+        m->strip.r_bound = rb;
         m->base.key = 0;
     }
     if (level == 0) return &m->strip; /* each base cell is swept once at level 0 */
-    if ((key = near_key(g, base, 1)) != m->base.key) {
+    if ((key = near_key(g, base, 1)) != m->base.key || r_hi > m->base.r_bound) {
         vpdsi_lattice_box(g, 0, base, lo, hi);
+        rb = near_bound(st, r_hi, g->dim, lo, hi);
+        if (rb > m->strip.r_bound) rb = m->strip.r_bound; /* a filter keeps a subset */
         m->base.n = vpdsi_kd_filter_near(&st->tree, &view, m->strip.idx, m->strip.n, lo, hi,
-                                         st->sizing.radius, scale, 0.0, m->base.idx);
+                                         rb, scale, 0.0, m->base.idx);
         m->base.key = key;
+        m->base.r_bound = rb;
     }
     return &m->base;
 }
@@ -548,9 +572,9 @@ static vpds_status gather_near(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_
         int k;
         for (k = 0; k < pb->dim; k++) base[k] = c[k] >> level; /* the base cell holding this one */
         m->n_cand = vpdsi_bgrid_near(&st->grid, vpdsi_bgrid_index(&st->grid, base), m->cand);
-    } else if (st->sizing.kind == VPDSI_SIZING_CONSTANT && !st->ogrid_mode) {
+    } else if (!st->ogrid_mode) {
         vpdsi_kd_samples view = vpdsi_store_view(st);
-        const vpdsi_near_list *near = near_lists(m, ctx, c, level, scale);
+        const vpdsi_near_list *near = near_lists(m, ctx, c, level, scale, r_hi);
         if (!near) goto oom;
         m->n_cand = vpdsi_kd_list_gather(&st->tree, &view, near->idx, near->n, lo, hi, r_hi,
                                          (int)pb->rule, scale, split, m->cand);

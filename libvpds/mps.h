@@ -35,6 +35,7 @@ typedef struct vpdsi_near_list {
     int32_t *idx; size_t n, cap;
     uint64_t key;                           /* which box; 0: none */
     size_t store_n;                         /* the store's count when searched */
+    double r_bound;                         /* it holds for cells of r <= r_bound */
 } vpdsi_near_list;
 
 typedef struct vpdsi_mps {
