@@ -111,8 +111,7 @@ int main(void)
     mine = scatter(tiling, engine_executor, 0);
     one = scatter(tiling, NULL, 1);
     framed = scatter_over_frames(tiling, &frames);
-    if (!mine || !one || !framed) return 1;
-    same = vpds_tiled_count(mine) == vpds_tiled_count(one) &&
+    same = mine && one && framed && vpds_tiled_count(mine) == vpds_tiled_count(one) &&
            memcmp(vpds_tiled_points(mine), vpds_tiled_points(one),
                   vpds_tiled_count(one) * 2 * sizeof(double)) == 0 &&
            vpds_tiled_count(framed) == vpds_tiled_count(one) &&

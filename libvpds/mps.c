@@ -490,7 +490,7 @@ static uint64_t near_key(const vpdsi_lattice *g, const uint64_t *base, uint64_t 
     return key + 1;
 }
 
-/* Half the diagonal of [lo, hi], doubled: the farthest two of its points lie apart. */
+/* The diagonal of [lo, hi]: how far apart two of its points can lie. */
 static double box_diagonal(int d, const double *lo, const double *hi)
 {
     double s = 0;

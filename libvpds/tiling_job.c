@@ -154,6 +154,12 @@ vpds_status vpds_tiling_job_step(vpds_tiling_job *j, uint64_t max_tiles, char *m
         if (j->b.failed != UINT64_MAX) /* the tiles that succeeded stay done */
             VPDSI_REFUSE(j->b.failed_st, "tile %llu (phase %d): %s",
                          (unsigned long long)j->tasks[j->b.failed], j->phase, j->b.failed_msg);
+        for (k = 0; k < n; k++) /* else the next step would hand it the same tasks forever */
+            if (!j->done[j->tasks[k]])
+                VPDSI_REFUSE(VPDS_ERR_STATE, "the executor returned without running task %llu of "
+                             "%llu (tile %llu, phase %d): it must run run(batch, i) for every i < n",
+                             (unsigned long long)k, (unsigned long long)n,
+                             (unsigned long long)j->tasks[k], j->phase);
     }
     return j->n_done < j->t->count ? VPDS_PAUSED : VPDS_OK;
 }

@@ -92,6 +92,13 @@ static void counting_executor(vpds_task_fn run, void *batch, uint64_t n, void *u
     for (i = 0; i < n; i++) run(batch, i);
 }
 
+/* An executor that runs only the first task of a batch: the job must refuse, not spin. */
+static void lazy_executor(vpds_task_fn run, void *batch, uint64_t n, void *user)
+{
+    (void)user;
+    if (n) run(batch, 0);
+}
+
 static vpds_tiled *run_with(const vpds_tiling *tg, int threads, vpds_executor_fn ex, void *user,
                             int safe)
 {
@@ -398,6 +405,25 @@ static void check_refusals(void)
         CHECK(vpds_tiling_job_result(job, NULL, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT);
         CHECK(vpds_tiling_job_step(job, 0, msg, sizeof msg) == VPDS_OK && vpds_tiling_job_tiles_done(job) == 4);
         vpds_tiling_job_destroy(job);
+    }
+    {
+        /* an executor that skips tasks (4 tiles a phase): refused, naming the task, the tile it
+         * ran kept */
+        uint64_t t4[2] = {4, 4};
+        vpds_tiling *tg4 = NULL;
+        vpds_tiling_job *job = NULL;
+        td.tiles = t4;
+        CHECK(vpds_tiling_create(&td, &tg4) == VPDS_OK);
+        rd = vpds_default_tiling_run_desc();
+        rd.executor = lazy_executor;
+        CHECK(vpds_tiling_job_create(tg4, &rd, &job, msg, sizeof msg) == VPDS_OK);
+        CHECK(vpds_tiling_job_step(job, 0, msg, sizeof msg) == VPDS_ERR_STATE);
+        CHECK_MSG(strstr(msg, "executor returned without running task 1 of 4") != NULL, "%s", msg);
+        CHECK(vpds_tiling_job_tiles_done(job) == 1);
+        vpds_tiling_job_destroy(job);
+        CHECK(vpds_tiling_run(tg4, &rd, &a, msg, sizeof msg) == VPDS_ERR_STATE && !a);
+        vpds_tiling_destroy(tg4);
+        td.tiles = tiles;
     }
     vpds_tiling_destroy(tg);
     /* windows per tile come from the caller */

@@ -3,6 +3,7 @@
  * for a tile sampled on demand through its cone, grid windows equal to the whole grid, and every
  * refused argument. */
 #include "check.h"
+#include "sampler.h" /* which index a run used */
 #include "vpds.h"
 #include <math.h>
 #include <stdint.h>
@@ -558,7 +559,7 @@ static void check_layout(void)
 
 /* Run [0,1]^dim at radius r with fixed points fx (nf, at r): its own samples into *own. */
 static size_t run_with_fixed(int dim, double r, uint64_t seed, const double *fx, size_t nf,
-                             double **own)
+                             int on_grid, double **own)
 {
     vpds_desc d = vpds_default_desc();
     vpds_sampler *s = NULL;
@@ -570,6 +571,11 @@ static size_t run_with_fixed(int dim, double r, uint64_t seed, const double *fx,
     *own = NULL;
     CHECK(vpds_create(&d, &s) == VPDS_OK);
     CHECK(vpds_add_points(s, fx, NULL, nf) == VPDS_OK);
+    /* paused once, to see which index the run is on (the store leaves it at the end) */
+    CHECK(vpds_set_budget(s, 50) == VPDS_OK && vpds_run(s) == VPDS_PAUSED);
+    CHECK_MSG(s->store.grid_mode == on_grid, "%dD, %zu fixed points: the run was %s the background grid",
+              dim, nf, on_grid ? "not on" : "on");
+    CHECK(vpds_set_budget(s, 0) == VPDS_OK);
     while ((st = vpds_run(s)) == VPDS_PAUSED) {}
     CHECK(st == VPDS_OK && vpds_count(s) >= nf);
     if (st == VPDS_OK && vpds_count(s) >= nf) {
@@ -621,9 +627,9 @@ static void check_fixed_on_grid(int dim, double r, uint64_t seed, size_t probes)
         free(fx);
         return;
     }
-    ng = run_with_fixed(dim, r, seed, fx, nf, &own_grid);
+    ng = run_with_fixed(dim, r, seed, fx, nf, 1, &own_grid);
     memcpy(fx + nf * (size_t)dim, fx + inside * (size_t)dim, (size_t)dim * sizeof(double));
-    nt = run_with_fixed(dim, r, seed, fx, nf + 1, &own_tree);
+    nt = run_with_fixed(dim, r, seed, fx, nf + 1, 0, &own_tree);
     CHECK_MSG(ng > 0 && ng == nt && own_grid && own_tree &&
                   memcmp(own_grid, own_tree, ng * (size_t)dim * sizeof(double)) == 0,
               "%dD fixed points: %zu own samples on the grid, %zu on the kd-tree, not the same",

@@ -182,8 +182,11 @@ def test_default_tiles_follow_the_box_and_the_radii():
     assert long.tiles[1] > 20 * long.tiles[0], long.tiles
     per = TilingSpec.make(3, None, radius=0.004, periodic=(True, False, True))
     assert per.tiles[0] % 2 == 0 and per.tiles[2] % 2 == 0 and min(per.tiles) >= 2
-    thin = TilingSpec.make(2, None, radius=0.0004, u_bounds=(1.0, 0.001))  # one row: the tiles as thick as allowed
-    assert thin.tiles[1] == 1 and thin.tiles[0] > 1
+    thin = TilingSpec.make(2, None, radius=0.0004, u_bounds=(1.0, 0.001))  # 5,000 samples: one tile
+    assert thin.tiles == (1, 1)
+    slab = TilingSpec.make(3, None, radius=0.0004, u_bounds=(1.0, 1.0, 0.001))  # the thin axis gets 1
+    assert slab.tiles[2] == 1 and slab.tiles[0] == slab.tiles[1]
+    assert 0.5 * T.TILE_SAMPLES < T.estimated_samples(slab) / np.prod(slab.tiles) < 2 * T.TILE_SAMPLES
     with pytest.raises(vpds.VpdsValueError, match=r"periodic\[1\]: the side 0.5"):  # the C message
         TilingSpec.make(2, None, radius=0.3, u_bounds=(1.0, 0.5), periodic=(False, True))
 

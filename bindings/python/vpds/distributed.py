@@ -143,6 +143,7 @@ def sample(store: Union[str, Path], d: int, tiles: Union[int, Sequence[int], Non
         nonce = uuid.uuid4().hex[:8]
         pending = set(todo)
         waiting: dict[int, int] = {}  # per submitted tile: its submitted dependents not yet done
+        finished: set[int] = set()
         for tile in tiling.order():
             if tile not in pending:
                 continue
@@ -158,12 +159,14 @@ def sample(store: Union[str, Path], d: int, tiles: Union[int, Sequence[int], Non
             if fut.status != "finished":
                 fut.result()  # raises the task's error (C message included)
             tile = back[fut.key]
+            finished.add(tile)
             # a tile's rim stays in the workers' memory only while a tile after it still runs
-            for k in [tile] + [k for k in tiling.deps(tile) if k in waiting]:
+            for k in [k for k in tiling.deps(tile) if k in waiting] + [tile]:
                 if k != tile:
                     waiting[k] -= 1
-                if waiting[k] == 0 and futures[k].done():
-                    del futures[k], waiting[k]
+                if waiting.get(k) == 0 and k in finished:
+                    futures.pop(k, None)
+                    waiting.pop(k, None)
             if bar is not None:
                 bar.update(1)
             if on_tile is not None:
@@ -189,12 +192,24 @@ def run_local(store: Union[str, Path], spec: TilingSpec, order: Optional[Iterabl
     tiling = Tiling(spec)
     out = _open_store(store, spec, tiling, overwrite)
     _TILINGS[spec.token] = tiling
-    rims: dict[int, Rim] = {}  # the tiles run here: what later tiles take from them
-    for tile in (tiling.order() if order is None else order):
+    tiles = list(tiling.order() if order is None else order)
+    # the tiles run here: what later tiles take from them, kept while one of those is to run
+    rims: dict[int, Rim] = {}
+    later: dict[int, int] = {}
+    for tile in tiles:
+        for k in tiling.deps(tile):
+            later[k] = later.get(k, 0) + 1
+    for tile in tiles:
         deps = tiling.deps(tile)
         missing = [k for k in deps if k not in rims and not out.complete(k)]
         if missing:
             raise ValueError(f"tile {tile} (phase {tiling.phase(tile)}) needs tiles {missing} first")
         given = [k for k in deps if k in rims]
-        rims[tile] = run_tile(spec, str(store), tile, given, *[rims[k] for k in given])
+        rim = run_tile(spec, str(store), tile, given, *[rims[k] for k in given])
+        if later.get(tile, 0):
+            rims[tile] = rim
+        for k in deps:
+            later[k] -= 1
+            if later[k] == 0:
+                rims.pop(k, None)
     return out

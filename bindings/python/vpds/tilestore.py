@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import json
 import os
-import threading
+import uuid
 from pathlib import Path
 from typing import Any, Iterator, Literal, Mapping, Optional, Sequence, Union, cast
 
@@ -32,11 +32,16 @@ def _json(doc: Mapping[str, Any]) -> bytes:
 
 
 def _write_file(path: Path, data: bytes) -> None:
-    """Replace path atomically (a temporary file renamed over it), as Zarr's local store does;
-    its directory exists."""
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
-    tmp.write_bytes(data)
-    os.replace(tmp, path)
+    """Replace path atomically: a temporary file of a unique name (two workers may write one
+    tile, a retried task beside one thought dead, on a shared filesystem) renamed over it, and
+    removed if the write fails; its directory exists."""
+    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
+    try:
+        tmp.write_bytes(data)
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
 
 
 def _write_array(path: Path, arr: npt.NDArray[np.float64]) -> None:

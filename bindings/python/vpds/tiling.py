@@ -151,45 +151,77 @@ TILE_SAMPLES = 200_000
 MIN_TILES, MIN_TILE_SAMPLES = 16, 20_000
 
 
+def _provisional(spec: TilingSpec) -> Tiling:
+    """The spec's tiling with the fewest tiles it allows (one per axis, two on a periodic one):
+    the whole box's descriptor and the margin."""
+    return Tiling(replace(spec, tiles=tuple(2 if spec.periodic and spec.periodic[k] else 1
+                                            for k in range(spec.d))))
+
+
 def estimated_samples(spec: TilingSpec) -> float:
     """Samples of the whole run (vpds_estimate on the whole box, within about 2x). A sizing
     read per tile (GridSource) is estimated at the geometric mean of its smallest and largest
     radius: the grid is not read whole."""
-    tg = Tiling(replace(spec, tiles=tuple(2 if spec.periodic and spec.periodic[k] else 1
-                                          for k in range(spec.d))))
+    tg = _provisional(spec)
     if isinstance(spec.sizing, GridSource) and spec.radius_min and spec.radius_max:
         tg._desc.radius = math.sqrt(spec.radius_min * spec.radius_max)  # make() read them
     sampler = created(lib.vpds_validate, lib.vpds_create, lib.vpds_destroy, "vpds_sampler", tg._desc)
     out = ffi.new("vpds_run_estimate *")
     st = lib.vpds_estimate(sampler, spec.scale, out)
-    if st != lib.VPDS_OK:
-        _raise(st, ffi.string(lib.vpds_last_error(sampler)).decode())
+    cause = take(tg._owner, "_callback_error") if tg._owner is not None else None
+    if st != lib.VPDS_OK or cause is not None:
+        message = ffi.string(lib.vpds_last_error(sampler)).decode()
+        if cause is None:
+            _raise(st, message)
+        raise_failure(st, message, cause, "sizing")
     return float(out.samples)
+
+
+def _cubic_counts(ext: Sequence[float], periodic: Sequence[bool], want: int) -> list[int]:
+    """About `want` near-cubic tiles over a box of extents ext: an axis shorter than a tile
+    gets one (two if periodic) and the other axes share the count."""
+    thin: dict[int, int] = {}
+    while True:
+        free = [k for k in range(len(ext)) if k not in thin]
+        if not free:
+            return [thin[k] for k in range(len(ext))]
+        rest = max(1.0, want / float(np.prod(list(thin.values()) or [1])))
+        side = (float(np.prod([ext[k] for k in free])) / rest) ** (1.0 / len(free))
+        short = [k for k in free if ext[k] < side]
+        if not short:
+            return [thin[k] if k in thin else max(1, round(ext[k] / side)) for k in range(len(ext))]
+        for k in short:
+            thin[k] = 2 if periodic[k] else 1
 
 
 def default_tiles(spec: TilingSpec) -> tuple[int, ...]:
     """The tile counts of tiles=None: from the box and the radii alone (through the estimate),
     never from the workers, so the same arguments give the same tiles, hence the same bytes,
     on any cluster and on a resume. Tiles near-cubic, of about TILE_SAMPLES samples (at least
-    MIN_TILES tiles while each keeps MIN_TILE_SAMPLES), even on periodic axes, and thinned
-    until the C tiling accepts them (a tile is no thinner than the margin)."""
+    MIN_TILES tiles while each keeps MIN_TILE_SAMPLES), even on periodic axes, no thinner than
+    the margin (the C tiling refuses thinner ones)."""
     n = estimated_samples(spec)
+    margin = _provisional(spec).margin
     want = max(math.ceil(n / TILE_SAMPLES), min(MIN_TILES, math.floor(n / MIN_TILE_SAMPLES)), 1)
     ext = [hi - lo for lo, hi in zip(spec.l_bounds, spec.u_bounds)]
-    side = (float(np.prod(ext)) / want) ** (1.0 / spec.d)
     per = spec.periodic or (False,) * spec.d
-    counts = [max(1, round(e / side)) for e in ext]
-    counts = [c + (c % 2) if per[k] else c for k, c in enumerate(counts)]
-    while True:
+    counts = []
+    for k, c in enumerate(_cubic_counts(ext, per, want)):
+        most = max(1, math.floor(ext[k] / margin)) if margin > 0 else c
+        c = min(c, most)
+        if per[k]:
+            c = max(2, c - (c % 2))
+        counts.append(c)
+    while True:  # the C check has the last word (its margin carries a relative slack)
         try:
             Tiling(replace(spec, tiles=tuple(counts)))
             return tuple(counts)
         except VpdsValueError:
-            k = int(np.argmax([c / e for c, e in zip(counts, ext)]))  # the thinnest tiles
-            floor = 2 if per[k] else 1
-            if counts[k] <= floor:
+            over = [k for k in range(spec.d) if counts[k] > (2 if per[k] else 1)]
+            if not over:
                 raise
-            counts[k] = max(floor, counts[k] - (2 if per[k] else 1))
+            k = max(over, key=lambda j: counts[j] / ext[j])  # the thinnest tiles that can thicken
+            counts[k] -= 2 if per[k] else 1
 
 
 class _CallbackOwner:
@@ -354,7 +386,9 @@ class Tiling:
         if st < 0:
             _raise(st, ffi.string(msg).decode())
         job = ffi.gc(job_out[0], lib.vpds_tiling_job_destroy)
-        step, total = _STEP_TILES_PER_THREAD * max(1, threads), int(self.count)
+        # a Python callable keeps the C run on this thread (the GIL): steps of one thread's share
+        busy = 1 if self._owner is not None else max(1, threads)
+        step, total = _STEP_TILES_PER_THREAD * busy, int(self.count)
         while True:
             st = lib.vpds_tiling_job_step(job, step, msg, 1024)
             cause = take(self._owner, "_callback_error")
