@@ -53,6 +53,14 @@ static size_t slot(int depth, int samples)
     return ((size_t)depth * 2 + (size_t)samples) * LIST_CAP;
 }
 
+double vpdsi_uncovered_nearest(const vpdsi_uncovered *u, const double *p)
+{
+    vpdsi_kd_samples v = vpdsi_uncovered_view(u);
+    int32_t arg;
+    if (!u->ready) return 0.0;
+    return vpdsi_kd_min_ratio(&u->tree, &v, p, 0.0, 1.0, (int)VPDS_RULE_PRIOR, &arg);
+}
+
 /* Whether a cell that may hold an uncovered point lies within thr of c2: exactly
  * vpdsi_uncovered_nearest(q->u, c2) <= thr, read from this box's list of centres when complete. */
 static int near_uncovered(bb_search *q, int depth, const double *c2, double thr)

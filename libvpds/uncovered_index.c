@@ -108,14 +108,6 @@ vpds_status vpdsi_uncovered_index(vpdsi_uncovered *u, vpdsi_store *st, const vpd
     return VPDS_OK;
 }
 
-double vpdsi_uncovered_nearest(const vpdsi_uncovered *u, const double *p)
-{
-    vpdsi_kd_samples v = vpdsi_uncovered_view(u);
-    int32_t arg;
-    if (!u->ready) return 0.0;
-    return vpdsi_kd_min_ratio(&u->tree, &v, p, 0.0, 1.0, (int)VPDS_RULE_PRIOR, &arg);
-}
-
 int vpdsi_uncovered_reserve_records(vpdsi_uncovered *u, vpdsi_mem *m, int dim, size_t more)
 {
     size_t n;

@@ -16,7 +16,9 @@ from ._scipy_compat import _optimization_name, _scipy_optimizers, _seed_from, _v
 from .sizing_grid import SizingGrid
 from ._typing import RngLike, SizingFunction
 from .estimate import Estimate
-from ._tiled import TilesLike, check_workers, refuse_with_tiles, tiled_fill
+from ._rules import RULES
+from ._tiled import TilesLike, refuse_with_tiles, tiled_fill
+from ._workers import check_workers
 
 __all__ = ["PoissonDisk", "SizingGrid", "VpdsError", "VpdsSizingError", "VpdsDomainError",
            "Progressive", "RULES", "ALGORITHM_VERSION", "MAX_DIM"]
@@ -25,8 +27,6 @@ __all__ = ["PoissonDisk", "SizingGrid", "VpdsError", "VpdsSizingError", "VpdsDom
 ALGORITHM_VERSION: int = int(lib.VPDS_ALGORITHM_VERSION)
 #: the largest dimension the library samples (VPDS_MAX_DIM)
 MAX_DIM: int = int(lib.VPDS_MAX_DIM)
-RULES = {"prior": lib.VPDS_RULE_PRIOR, "current": lib.VPDS_RULE_CURRENT,
-         "bigger": lib.VPDS_RULE_BIGGER, "smaller": lib.VPDS_RULE_SMALLER}
 # work units (darts + cells) per C call in a fill: small enough for a responsive Ctrl-C and
 # progress bar, large enough that the calls cost nothing measurable
 _CHUNK = 50_000

@@ -8,8 +8,6 @@ stays serial."""
 from __future__ import annotations
 
 import math
-import numbers
-import os
 from typing import Any, Optional, Sequence, Union
 
 import numpy as np
@@ -22,19 +20,6 @@ TilesLike = Union[None, str, int, Sequence[int]]
 # the seams (a margin on each side) cost little, small enough for a few tiles per phase
 _AUTO_SIDE = {1: 4096.0, 2: 64.0, 3: 12.0}
 _AUTO_SIDE_HIGH = 6.0
-
-
-def check_workers(workers: Any) -> int:
-    """An int >= 1, or -1 for every core (scipy's spelling)."""
-    if not isinstance(workers, (numbers.Integral, np.integer)) or isinstance(workers, bool) or \
-            not (int(workers) == -1 or int(workers) >= 1):
-        raise ValueError(f"workers = {workers!r}: must be an int >= 1, or -1 for every core")
-    return int(workers)
-
-
-def threads_for(workers: int) -> int:
-    """Threads for a worker count (-1: every core)."""
-    return (os.cpu_count() or 1) if workers == -1 else workers
 
 
 def auto_tiles(lo: npt.NDArray[np.float64], hi: npt.NDArray[np.float64],

@@ -16,13 +16,14 @@ import numpy as np
 import numpy.typing as npt
 
 from ._callbacks import raise_failure, take
-from ._core import RULES, SizingGrid
+from ._rules import RULES
 from ._errors import VpdsValueError, _raise, created
 from ._scipy_compat import _seed_from
-from ._tiled import check_workers, threads_for
+from ._workers import check_workers, threads_for
 from ._typing import BoundsLike, RngLike, SizingFunction
 from ._vpds import ffi, lib
 from .gridsource import GridSource
+from .sizing_grid import SizingGrid
 
 __all__ = ["TilingSpec", "Tiling"]
 
