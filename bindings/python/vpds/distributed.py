@@ -67,6 +67,18 @@ def run_tile(spec: TilingSpec, path: str, tile: int, dep_tiles: Sequence[int] = 
     return tiling.rim(tile, x, r)
 
 
+def _dependents(tiling: Tiling, tiles: Sequence[int]) -> dict[int, int]:
+    """Per tile of `tiles`: how many of `tiles` take its rim (the others' samples are read from
+    the store), so that a rim is let go once they have run."""
+    inside = set(tiles)
+    count = {k: 0 for k in tiles}
+    for tile in tiles:
+        for k in tiling.deps(tile):
+            if k in inside:
+                count[k] += 1
+    return count
+
+
 def _open_store(store: Union[str, Path], spec: TilingSpec, tiling: Tiling, overwrite: bool) -> TileStore:
     path = Path(store)
     if overwrite and path.exists():
@@ -142,15 +154,11 @@ def sample(store: Union[str, Path], d: int, tiles: Union[int, Sequence[int], Non
         spec_f = client.scatter(spec, broadcast=True, hash=False)
         nonce = uuid.uuid4().hex[:8]
         pending = set(todo)
-        waiting: dict[int, int] = {}  # per submitted tile: its submitted dependents not yet done
+        submitted = [k for k in tiling.order() if k in pending]
+        waiting = _dependents(tiling, submitted)  # per tile: its dependents not yet done
         finished: set[int] = set()
-        for tile in tiling.order():
-            if tile not in pending:
-                continue
+        for tile in submitted:
             deps = [k for k in tiling.deps(tile) if k in futures]
-            for k in deps:
-                waiting[k] += 1
-            waiting[tile] = 0
             futures[tile] = client.submit(run_tile, spec_f, str(store), tile, deps,
                                           *[futures[k] for k in deps],
                                           key=f"vpds-tile-{spec.token[:8]}-{nonce}-{tile}", pure=False)
@@ -161,9 +169,10 @@ def sample(store: Union[str, Path], d: int, tiles: Union[int, Sequence[int], Non
             tile = back[fut.key]
             finished.add(tile)
             # a tile's rim stays in the workers' memory only while a tile after it still runs
-            for k in [k for k in tiling.deps(tile) if k in waiting] + [tile]:
-                if k != tile:
+            for k in tiling.deps(tile):
+                if k in waiting:
                     waiting[k] -= 1
+            for k in [*tiling.deps(tile), tile]:
                 if waiting.get(k) == 0 and k in finished:
                     futures.pop(k, None)
                     waiting.pop(k, None)
@@ -195,10 +204,7 @@ def run_local(store: Union[str, Path], spec: TilingSpec, order: Optional[Iterabl
     tiles = list(tiling.order() if order is None else order)
     # the tiles run here: what later tiles take from them, kept while one of those is to run
     rims: dict[int, Rim] = {}
-    later: dict[int, int] = {}
-    for tile in tiles:
-        for k in tiling.deps(tile):
-            later[k] = later.get(k, 0) + 1
+    later = _dependents(tiling, tiles)
     for tile in tiles:
         deps = tiling.deps(tile)
         missing = [k for k in deps if k not in rims and not out.complete(k)]
@@ -206,10 +212,10 @@ def run_local(store: Union[str, Path], spec: TilingSpec, order: Optional[Iterabl
             raise ValueError(f"tile {tile} (phase {tiling.phase(tile)}) needs tiles {missing} first")
         given = [k for k in deps if k in rims]
         rim = run_tile(spec, str(store), tile, given, *[rims[k] for k in given])
-        if later.get(tile, 0):
+        if later[tile]:
             rims[tile] = rim
-        for k in deps:
+        for k in given:
             later[k] -= 1
             if later[k] == 0:
-                rims.pop(k, None)
+                del rims[k]
     return out

@@ -144,8 +144,8 @@ class TilingSpec:
                 "radius_max": self.radius_max, "seed": self.seed, "scale": self.scale}
 
 
-#: tiles=None: tiles of about this many samples (a second or so of work each: the per-tile cost
-#: of a Dask task, its Zarr write and its neighbours' rims, about 10 ms, stays near 1%) ...
+#: tiles=None: tiles of about this many samples (about a second of work each: the per-tile cost
+#: of a Dask task, its Zarr write and its rim, 54-91 ms measured, stays under a tenth) ...
 TILE_SAMPLES = 200_000
 #: ... and at least MIN_TILES of them while each still holds MIN_TILE_SAMPLES, so that the
 #: workers of a machine or two share even a smaller run
@@ -159,11 +159,12 @@ def _provisional(spec: TilingSpec) -> Tiling:
                                             for k in range(spec.d))))
 
 
-def estimated_samples(spec: TilingSpec) -> float:
-    """Samples of the whole run (vpds_estimate on the whole box, within about 2x). A sizing
-    read per tile (GridSource) is estimated at the geometric mean of its smallest and largest
-    radius: the grid is not read whole."""
-    tg = _provisional(spec)
+def estimated_samples(spec: TilingSpec, provisional: Optional[Tiling] = None) -> float:
+    """Samples of the whole run (vpds_estimate on the whole box, within about 2x), through the
+    spec's _provisional tiling (made here unless given). A sizing read per tile (GridSource) is
+    estimated at the geometric mean of its smallest and largest radius: the grid is not read
+    whole."""
+    tg = provisional or _provisional(spec)
     if isinstance(spec.sizing, GridSource) and spec.radius_min and spec.radius_max:
         tg._desc.radius = math.sqrt(spec.radius_min * spec.radius_max)  # make() read them
     sampler = created(lib.vpds_validate, lib.vpds_create, lib.vpds_destroy, "vpds_sampler", tg._desc)
@@ -201,8 +202,9 @@ def default_tiles(spec: TilingSpec) -> tuple[int, ...]:
     on any cluster and on a resume. Tiles near-cubic, of about TILE_SAMPLES samples (at least
     MIN_TILES tiles while each keeps MIN_TILE_SAMPLES), even on periodic axes, no thinner than
     the margin (the C tiling refuses thinner ones)."""
-    n = estimated_samples(spec)
-    margin = _provisional(spec).margin
+    whole = _provisional(spec)
+    margin = whole.margin
+    n = estimated_samples(spec, whole)
     want = max(math.ceil(n / TILE_SAMPLES), min(MIN_TILES, math.floor(n / MIN_TILE_SAMPLES)), 1)
     ext = [hi - lo for lo, hi in zip(spec.l_bounds, spec.u_bounds)]
     per = spec.periodic or (False,) * spec.d
