@@ -46,8 +46,11 @@ extern "C" {
  * (versions 1-2 searched the whole box at once and could give up with VPDS_ERR_DOMAIN; other
  * points for vpds_next after vpds_run). 4: with two radii the coverage search keeps what it
  * learns (cells shown covered, witness points) and a dart asks only about the cells near it;
- * the points of version 3 except where the search's box budget or precision decided. */
-#define VPDS_ALGORITHM_VERSION 4
+ * the points of version 3 except where the search's box budget or precision decided. 5: with a
+ * constant radius and no domain (dim <= 4) the stream finds the largest gap exactly, at a vertex
+ * of the bisectors of the few samples near it, instead of to the tolerance (other points for
+ * vpds_next; the runs give the points of version 4). */
+#define VPDS_ALGORITHM_VERSION 5
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 16
 /* Relative tolerance eps of the continuous stream (vpds_next): each t it reports is an upper

@@ -9,6 +9,7 @@
  * maximiser y*: y* itself with one radius (farthest-point insertion), else a point drawn
  * uniformly from those that are free at t* * inhibition and cover y* at t* * coverage. */
 #include "stream.h"
+#include "gap_search.h"
 #include "rules.h"
 #include "torus.h"
 #include <math.h>
@@ -33,6 +34,9 @@ void vpdsi_stream_release(vpdsi_stream *sm, vpdsi_mem *m)
     vpdsi_mem_free(m, sm->buf, sm->cap_buf * sizeof(double));
     vpdsi_mem_free(m, sm->kids, sm->cap_kids * sizeof(double));
     vpdsi_mem_free(m, sm->kid_cells, sm->cap_kid_cells * sizeof(uint64_t));
+    vpdsi_mem_free(m, sm->cand, sm->cap_cand * sizeof(int32_t));
+    vpdsi_mem_free(m, sm->cand_x, sm->cap_cand_x * sizeof(double));
+    vpdsi_mem_free(m, sm->lists, sm->cap_lists * sizeof(int32_t));
     vpdsi_stream_init(sm);
 }
 
@@ -331,6 +335,122 @@ static vpds_status search_diverged(const vpdsi_ctx *ctx, const double *centre)
     return VPDS_ERR_DOMAIN;
 }
 
+/* ---- version 5: the exact maximum of g over a region, with one radius ---- */
+
+#define EXACT_ROUNDING 1e-12 /* the bound's margin over the maximum found: its round-off */
+
+/* Whether a region's maximum of g can be found exactly: with a constant radius g is the
+ * distance to the nearest sample over coverage * r, and the largest gap of a box among the few
+ * samples that can be nearest in it is a vertex of their bisectors (gap.c, gap_search.c). */
+static int exact_applies(const vpdsi_ctx *ctx)
+{
+    return ctx->pb->algorithm >= 5 && ctx->st->sizing.kind == VPDSI_SIZING_CONSTANT &&
+           !ctx->dom->fn && ctx->pb->dim <= VPDSI_GAP_MAX_DIM;
+}
+
+#define EXACT_MAX_IMAGES 4096 /* candidate images one region takes; past it, the search */
+
+/* The images of sample x within R of the centre along every axis: their count (0 when more
+ * than `room`), written d apart to out. Several per sample when a periodic axis is short. */
+static size_t images_near(const vpdsi_problem *pb, const double *x, const double *centre, double R,
+                          double *out, size_t room)
+{
+    long first[VPDS_MAX_DIM], count[VPDS_MAX_DIM], m[VPDS_MAX_DIM];
+    size_t total = 1, i;
+    int d = pb->dim, k;
+    for (k = 0; k < d; k++) {
+        double P = pb->period[k];
+        first[k] = 0;
+        count[k] = 1;
+        if (P > 0) {
+            first[k] = (long)ceil((centre[k] - R - x[k]) / P);
+            count[k] = (long)floor((centre[k] + R - x[k]) / P) - first[k] + 1;
+            if (count[k] < 1) count[k] = 1; /* round-off: the nearest image stays */
+        }
+        if ((double)total * (double)count[k] > (double)room) return 0;
+        total *= (size_t)count[k];
+        m[k] = 0;
+    }
+    for (i = 0; i < total; i++) {
+        for (k = 0; k < d; k++) out[i * (size_t)d + k] = x[k] + pb->period[k] * (double)(first[k] + m[k]);
+        for (k = 0; k < d && ++m[k] == count[k]; k++) m[k] = 0;
+    }
+    return total;
+}
+
+/* The region's candidates: the images of every sample within the reach of the nearest one's
+ * farthest corner (Euclidean distance to them is then the torus distance); *usable = 0 when
+ * there are too many, or a sample's radius (a fixed point's) is not the sizing's. */
+static vpds_status gather_exact(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centre,
+                                const double *half, int *usable, size_t *n_images)
+{
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_store *st = ctx->st;
+    vpdsi_kd_samples v = vpdsi_store_view(st);
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], h2 = 0, R;
+    int d = pb->dim, k;
+    int32_t arg;
+    size_t i, n = 0;
+    *usable = 0;
+    /* a fixed point of a larger radius may be nearest in the rule's distance from afar */
+    if (st->tree.n_nodes == 0 || st->tree.nodes[0].rmax > st->sizing.radius) return VPDS_OK;
+    for (k = 0; k < d; k++) {
+        lo[k] = centre[k] - half[k];
+        hi[k] = centre[k] + half[k];
+        h2 += half[k] * half[k];
+    }
+    vpdsi_kd_min_ratio(&st->tree, &v, centre, 0.0, st->sizing.radius, (int)pb->rule, &arg);
+    if (arg < 0) return VPDS_OK;
+    R = (sqrt(vpdsi_box_maxdist2(&st->tree, st->x + (size_t)arg * d, lo, hi)) + sqrt(h2)) * (1 + 1e-9);
+    sm->n_cand = 0;
+    if (vpdsi_kd_radius(&st->tree, &v, centre, R, ctx->mem, &sm->cand, &sm->n_cand, &sm->cap_cand) ||
+        vpdsi_mem_reserve(ctx->mem, (void **)&sm->cand_x, &sm->cap_cand_x,
+                          EXACT_MAX_IMAGES * (size_t)d, sizeof(double)) ||
+        vpdsi_mem_reserve(ctx->mem, (void **)&sm->lists, &sm->cap_lists,
+                          VPDSI_GAP_SCRATCH(EXACT_MAX_IMAGES), sizeof(int32_t))) {
+        vpdsi_store_error(st, "out of memory in the stream's search");
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    for (i = 0; i < sm->n_cand; i++) {
+        size_t got;
+        if (st->r[sm->cand[i]] != st->sizing.radius) return VPDS_OK;
+        got = images_near(pb, st->x + (size_t)sm->cand[i] * d, centre, R, sm->cand_x + n * (size_t)d,
+                          EXACT_MAX_IMAGES - n);
+        if (got == 0) return VPDS_OK;
+        n += got;
+    }
+    *n_images = n;
+    *usable = 1;
+    return VPDS_OK;
+}
+
+/* The maximum of g over the region exactly (*solved = 1): *bound just above it, y where it is
+ * and *gy = g(y); or *solved = 0 for the best-first search. */
+static vpds_status exact_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centre,
+                                const double *half, double *bound, double *y, double *gy,
+                                int *solved)
+{
+    const vpdsi_problem *pb = ctx->pb;
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], g, ub, best, zero[VPDS_MAX_DIM] = {0};
+    int d = pb->dim, k, usable;
+    size_t n_images = 0;
+    vpds_status e;
+    *solved = 0;
+    if ((e = gather_exact(sm, ctx, centre, half, &usable, &n_images)) != VPDS_OK || !usable) return e;
+    for (k = 0; k < d; k++) {
+        lo[k] = centre[k] - half[k];
+        hi[k] = centre[k] + half[k];
+    }
+    if (!vpdsi_gap_search(d, lo, hi, sm->cand_x, (int)n_images, sm->lists, &best, y)) return VPDS_OK;
+    vpdsi_store_wrap(ctx->st, y);
+    if ((e = eval_boxes(sm, ctx, y, 1, zero, gy, &ub)) != VPDS_OK) return e;
+    g = sqrt(best) / (vpdsi_rule_f(pb->rule, ctx->st->sizing.radius, ctx->st->sizing.radius) *
+                      pb->coverage);
+    *bound = (g > *gy ? g : *gy) * (1 + EXACT_ROUNDING);
+    *solved = 1;
+    return VPDS_OK;
+}
+
 /* Best-first search for the maximum of g over one region, to the tolerance: *bound is an upper
  * bound of g over the region and g(y) = *gy >= *bound / (1 + tolerance). With a domain the
  * tolerance is VPDS_STREAM_DOMAIN_TOLERANCE: on a curved boundary g is often maximal where it
@@ -345,6 +465,14 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
     region_search q;
     long splits;
     vpds_status e;
+    if (exact_applies(ctx)) {
+        int solved;
+        if ((e = exact_region(sm, ctx, centre, half, bound, y, gy, &solved)) != VPDS_OK) return e;
+        if (solved) {
+            if (lb && *gy > *lb) *lb = *gy;
+            return VPDS_OK;
+        }
+    }
     q.tol = stream_tolerance(ctx);
     q.extra = -1;
     q.y = y;
@@ -553,7 +681,8 @@ static vpds_status bound_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, double k
                                 double *bound, double *y, double *gy)
 {
     int v3 = ctx->pb->algorithm >= 3;
-    double tol = stream_tolerance(ctx);
+    /* version 5's exact search: a cached point is the maximiser only when it is the key's */
+    double tol = exact_applies(ctx) ? 2 * EXACT_ROUNDING : stream_tolerance(ctx);
     /* version 3 stops a search below the next key, so a cached point is the region's
      * maximiser only when it is within the tolerance of the key */
     if (*gy >= 0 && (!v3 || *gy * (1 + tol) >= key)) {

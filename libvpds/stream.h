@@ -21,6 +21,10 @@ typedef struct vpdsi_stream {
     double lb;                     /* version 3: the largest g seen while the store held lb_n */
     size_t lb_n;                   /* samples (lb is -1 once a sample is added) */
     size_t cap_buf;
+    /* version 5: the exact search of a region (exact_region in stream.c) */
+    int32_t *cand; size_t n_cand, cap_cand; /* samples within reach of the region */
+    double *cand_x; size_t cap_cand_x;      /* their images within reach of it */
+    int32_t *lists; size_t cap_lists;       /* the candidates left at each depth of the split */
 } vpdsi_stream;
 
 void vpdsi_stream_init(vpdsi_stream *sm);

@@ -1,6 +1,7 @@
 """The Python binding: a drop-in for scipy.stats.qmc.PoissonDisk, numpy results, errors as
 exceptions with the C message, callbacks, Ctrl-C, determinism, copies that outlive the engine."""
 import gc
+import itertools
 import sys
 
 import numpy as np
@@ -217,9 +218,10 @@ def test_callable_sampled_onto_a_grid_is_an_approximation_with_its_own_l():
 def test_algorithm_version_pins_the_points():
     """Version 1 keeps the points made before version 2 changed the two-radii coverage search;
     one radius is the same under both; version 3 changed only the stream (a run's points are
-    those of version 2); version 4 made the search learn, with the points of version 3; a
-    version the library does not have is refused."""
-    assert vpds.ALGORITHM_VERSION == 4
+    those of version 2); version 4 made the search learn, with the points of version 3;
+    version 5 made the stream of one radius exact (its runs are version 4's); a version the
+    library does not have is refused."""
+    assert vpds.ALGORITHM_VERSION == 5
 
     def fill(version, inhibition):
         engine = vpds.PoissonDisk(2, sizing=lambda x: 0.04 + 0.04 * x[:, 0], lipschitz=0.04,
@@ -229,10 +231,19 @@ def test_algorithm_version_pins_the_points():
 
     current, v1, v2, v3 = fill(None, 0.6), fill(1, 0.6), fill(2, 0.6), fill(3, 0.6)
     assert np.array_equal(current, fill(4, 0.6))
+    assert np.array_equal(current, fill(5, 0.6))
     assert np.array_equal(current, v3)
     assert np.array_equal(v2, v3)
     assert not np.array_equal(v1, v2)
     assert np.array_equal(fill(1, 1.0), fill(2, 1.0))
-    for bad in (5, -1, 1.5, True):
-        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.4"):
+
+    def stream(version):
+        engine = vpds.PoissonDisk(2, sizing=0.05, seed=3, algorithm_version=version)
+        return np.array([x for x, _ in itertools.islice(engine.stream(), 200)])
+
+    # the stream: version 5's farthest points differ from version 4's (to the tolerance)
+    assert np.array_equal(stream(None), stream(5))
+    assert not np.array_equal(stream(5), stream(4))
+    for bad in (6, -1, 1.5, True):
+        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.5"):
             vpds.PoissonDisk(2, algorithm_version=bad)

@@ -119,7 +119,8 @@ class PoissonDisk:
                   version 2 changed the coverage search of two radii, 2 streams made
                   before version 3 changed the stream after a run; 3 the points of a run
                   before version 4's coverage search learnt (the same points, except where
-                  the search's box budget or precision decided).
+                  the search's box budget or precision decided); 4 streams made before
+                  version 5 found the farthest point exactly (one constant radius, no domain).
       memory_limit: most bytes the C sampler may hold (None: no limit); a run whose estimate
                   (`estimate()`) exceeds it is refused before it starts, and an allocation past
                   it fails cleanly: MemoryError, the sampler as it was.

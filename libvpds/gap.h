@@ -1,0 +1,18 @@
+/* The largest gap in a box among a few points: max over y in [lo, hi] of min_i |y - p_i|, found
+ * exactly up to round-off (the stream's exact local search, algorithm version 5). */
+#ifndef VPDS_GAP_H
+#define VPDS_GAP_H
+
+#define VPDSI_GAP_MAX_DIM 4    /* the vertex enumeration grows as C(n, d + 1) 2^d: small d only */
+#define VPDSI_GAP_MAX_POINTS 10 /* points one enumeration takes */
+
+/* The squared largest gap, and its maximiser in y; p holds n points of dim coordinates (n >= 1,
+ * n <= VPDSI_GAP_MAX_POINTS, dim <= VPDSI_GAP_MAX_DIM), anywhere in space (no torus: the caller
+ * passes the images that matter). */
+double vpdsi_gap_max(int dim, const double *lo, const double *hi, const double *p, int n, double *y);
+
+/* Whether p_j is nowhere in the box nearer than p_i: |y - p_i| < |y - p_j| for every y in it
+ * (the difference of squares is linear in y, so its largest value over the box is per axis). */
+int vpdsi_gap_dominated(int dim, const double *lo, const double *hi, const double *pi,
+                        const double *pj);
+#endif
