@@ -378,18 +378,18 @@ static size_t images_near(const vpdsi_problem *pb, const double *x, const double
     return total;
 }
 
-/* The region's candidates: the images of every sample within the reach of the nearest one's
- * farthest corner (Euclidean distance to them is then the torus distance); *usable = 0 when
- * there are too many, or a sample's radius (a fixed point's) is not the sizing's. */
+/* The region's candidates: the images of every sample that may be nearest somewhere in it (within
+ * the region's key, else the nearest one's farthest corner; Euclidean distance to them is then
+ * the torus distance); *usable = 0 when there are too many, or a sample's radius (a fixed
+ * point's) is not the sizing's. */
 static vpds_status gather_exact(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centre,
-                                const double *half, int *usable, size_t *n_images)
+                                const double *half, double key, int *usable, size_t *n_images)
 {
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_store *st = ctx->st;
     vpdsi_kd_samples v = vpdsi_store_view(st);
     double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], h2 = 0, R;
     int d = pb->dim, k;
-    int32_t arg;
     size_t i, n = 0;
     *usable = 0;
     /* a fixed point of a larger radius may be nearest in the rule's distance from afar */
@@ -399,9 +399,17 @@ static vpds_status gather_exact(vpdsi_stream *sm, const vpdsi_ctx *ctx, const do
         hi[k] = centre[k] + half[k];
         h2 += half[k] * half[k];
     }
-    vpdsi_kd_min_ratio(&st->tree, &v, centre, 0.0, st->sizing.radius, (int)pb->rule, &arg);
-    if (arg < 0) return VPDS_OK;
-    R = (sqrt(vpdsi_box_maxdist2(&st->tree, st->x + (size_t)arg * d, lo, hi)) + sqrt(h2)) * (1 + 1e-9);
+    if (isfinite(key)) {
+        /* the key bounds g over the region (samples only lower g): no point of it is farther
+         * than key * coverage * r from its nearest sample */
+        R = key * pb->coverage * st->sizing.radius;
+    } else {
+        int32_t arg;
+        vpdsi_kd_min_ratio(&st->tree, &v, centre, 0.0, st->sizing.radius, (int)pb->rule, &arg);
+        if (arg < 0) return VPDS_OK;
+        R = sqrt(vpdsi_box_maxdist2(&st->tree, st->x + (size_t)arg * d, lo, hi));
+    }
+    R = (R + sqrt(h2)) * (1 + 1e-9);
     sm->n_cand = 0;
     if (vpdsi_kd_radius(&st->tree, &v, centre, R, ctx->mem, &sm->cand, &sm->n_cand, &sm->cap_cand) ||
         vpdsi_mem_reserve(ctx->mem, (void **)&sm->cand_x, &sm->cap_cand_x,
@@ -425,28 +433,28 @@ static vpds_status gather_exact(vpdsi_stream *sm, const vpdsi_ctx *ctx, const do
 }
 
 /* The maximum of g over the region exactly (*solved = 1): *bound just above it, y where it is
- * and *gy = g(y); or *solved = 0 for the best-first search. */
+ * and *gy = g(y); or *solved = 0 for the best-first search. key: the region's key, an upper
+ * bound of g there. */
 static vpds_status exact_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centre,
-                                const double *half, double *bound, double *y, double *gy,
-                                int *solved)
+                                const double *half, double key, double *bound, double *y,
+                                double *gy, int *solved)
 {
     const vpdsi_problem *pb = ctx->pb;
-    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], g, ub, best, zero[VPDS_MAX_DIM] = {0};
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], best;
     int d = pb->dim, k, usable;
     size_t n_images = 0;
     vpds_status e;
     *solved = 0;
-    if ((e = gather_exact(sm, ctx, centre, half, &usable, &n_images)) != VPDS_OK || !usable) return e;
+    if ((e = gather_exact(sm, ctx, centre, half, key, &usable, &n_images)) != VPDS_OK || !usable)
+        return e;
     for (k = 0; k < d; k++) {
         lo[k] = centre[k] - half[k];
         hi[k] = centre[k] + half[k];
     }
     if (!vpdsi_gap_search(d, lo, hi, sm->cand_x, (int)n_images, sm->lists, &best, y)) return VPDS_OK;
     vpdsi_store_wrap(ctx->st, y);
-    if ((e = eval_boxes(sm, ctx, y, 1, zero, gy, &ub)) != VPDS_OK) return e;
-    g = sqrt(best) / (vpdsi_rule_f(pb->rule, ctx->st->sizing.radius, ctx->st->sizing.radius) *
-                      pb->coverage);
-    *bound = (g > *gy ? g : *gy) * (1 + EXACT_ROUNDING);
+    *gy = sqrt(best) / (pb->coverage * ctx->st->sizing.radius);
+    *bound = *gy * (1 + EXACT_ROUNDING);
     *solved = 1;
     return VPDS_OK;
 }
@@ -456,8 +464,8 @@ static vpds_status exact_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const do
  * tolerance is VPDS_STREAM_DOMAIN_TOLERANCE: on a curved boundary g is often maximal where it
  * varies quadratically along the boundary, so a tolerance eps costs about 1/eps boxes there. */
 static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centre,
-                                 const double *half, double next, double *lb, double *bound,
-                                 double *y, double *gy)
+                                 const double *half, double key, double next, double *lb,
+                                 double *bound, double *y, double *gy)
 {
     int d = ctx->pb->dim, k;
     size_t w = 1 + 2 * (size_t)d;
@@ -467,7 +475,7 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
     vpds_status e;
     if (exact_applies(ctx)) {
         int solved;
-        if ((e = exact_region(sm, ctx, centre, half, bound, y, gy, &solved)) != VPDS_OK) return e;
+        if ((e = exact_region(sm, ctx, centre, half, key, bound, y, gy, &solved)) != VPDS_OK) return e;
         if (solved) {
             if (lb && *gy > *lb) *lb = *gy;
             return VPDS_OK;
@@ -680,22 +688,23 @@ static vpds_status bound_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, double k
                                 double *lb, const double *centre, const double *half,
                                 double *bound, double *y, double *gy)
 {
-    int v3 = ctx->pb->algorithm >= 3;
+    int v3 = ctx->pb->algorithm >= 3, exact = exact_applies(ctx);
     /* version 5's exact search: a cached point is the maximiser only when it is the key's */
-    double tol = exact_applies(ctx) ? 2 * EXACT_ROUNDING : stream_tolerance(ctx);
+    double tol = exact ? 2 * EXACT_ROUNDING : stream_tolerance(ctx);
     /* version 3 stops a search below the next key, so a cached point is the region's
      * maximiser only when it is within the tolerance of the key */
     if (*gy >= 0 && (!v3 || *gy * (1 + tol) >= key)) {
         double g1, ub1, zero[VPDS_MAX_DIM] = {0};
         vpds_status e = eval_boxes(sm, ctx, y, 1, zero, &g1, &ub1);
         if (e != VPDS_OK) return e;
-        if (g1 == *gy) {
+        /* (the exact search's g(y) is its own arithmetic's: equal to round-off) */
+        if (g1 == *gy || (exact && g1 >= *gy * (1 - EXACT_ROUNDING))) {
             *bound = key;
             if (v3 && g1 > *lb) *lb = g1;
             return VPDS_OK;
         }
     }
-    return search_region(sm, ctx, centre, half, next, v3 ? lb : NULL, bound, y, gy);
+    return search_region(sm, ctx, centre, half, key, next, v3 ? lb : NULL, bound, y, gy);
 }
 
 /* The sample of an event at t that covers y: y itself with one radius, else a point drawn

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+static int quick; /* VPDS_TEST_QUICK (valgrind): fewer configurations */
 static unsigned long long rng_state = 12345;
 static double unit(void)
 {
@@ -188,7 +189,7 @@ static void check_search(void)
     static int32_t scratch[VPDSI_GAP_SCRATCH(400)];
     double p[400 * 4], y[4], best;
     int trial, i, k;
-    for (trial = 0; trial < 300; trial++) {
+    for (trial = 0; trial < (quick ? 40 : 300); trial++) {
         double lo[2] = {0, 0}, hi[2] = {1, 1};
         int n = 1 + trial % 120, side = 2 + trial % 9;
         for (i = 0; i < 2 * n; i++) p[i] = unit() * 1.4 - 0.2;
@@ -205,7 +206,7 @@ static void check_search(void)
         CHECK_MSG(fabs(best / truth - 1) < 1e-10, "n %d: %.17g, brute force %.17g", n, best, truth);
         CHECK(fabs(nearest2(2, p, n, y) / best - 1) < 1e-10);
     }
-    for (trial = 0; trial < 60; trial++) {
+    for (trial = 0; trial < (quick ? 6 : 60); trial++) {
         int d = 3 + trial % 2, n = 50 + trial * 5;
         double lo[4], hi[4], top = 0;
         for (k = 0; k < d; k++) {
@@ -310,11 +311,12 @@ int main(void)
 {
     static const int both[2] = {1, 1}, one3[3] = {0, 1, 0};
     int d, n, rep;
+    quick = getenv("VPDS_TEST_QUICK") != NULL;
     check_gap_known();
     for (d = 1; d <= VPDSI_GAP_MAX_DIM; d++) {
         check_dominated(d);
         for (n = 1; n <= VPDSI_GAP_MAX_POINTS; n++)
-            for (rep = 0; rep < (d > 2 ? 40 : 100); rep++) check_gap_once(d, n, d > 2 ? 3000 : 2000);
+            for (rep = 0; rep < (quick ? 5 : d > 2 ? 40 : 100); rep++) check_gap_once(d, n, d > 2 ? 3000 : 2000);
     }
     check_search();
     check_stream_brute(1, 0, 64);
