@@ -3,7 +3,7 @@
  * usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION [VERSION] | ramp RULE | floor N DIM
  *        | tworamp3 VERSION (3D two radii R_f = 0.5 R_c, r = 0.03 + 0.12 x0, periodic axes 1 and 2,
  *          rule bigger, at algorithm_version VERSION: a fuzz input's workload)
- *        | annulus RADIUS (a domain) | stream DIM RADIUS N STEPS [VERSION] (prints one line per N/STEPS samples: the cost along n)
+ *        | annulus RADIUS (a domain) | stream DIM RADIUS N STEPS [VERSION [INHIBITION]] (prints one line per N/STEPS samples: the cost along n)
  *        | threads DIM RADIUS TILES THREADS (vpds_tiling_run of TILES per axis on THREADS threads)
  *        | rampthreads RULE TILES_X TILES_Y THREADS (the ramp's box tiled so, its sizing thread-safe)
  *        | tilestats DIM RADIUS TILES (the speed-up model's inputs: one run, each phase's tile work
@@ -348,6 +348,7 @@ int main(int argc, char **argv)
         d.dim = atoi(argv[2]);
         d.radius = atof(argv[3]);
         if (argc >= 7) d.algorithm_version = (uint32_t)atoi(argv[6]);
+        if (argc >= 8) d.inhibition = atof(argv[7]);
         return stream(&d, (size_t)atof(argv[4]), (size_t)atoi(argv[5]));
     }
     if (argc >= 3 && (!strcmp(argv[1], "ramp") || (argc >= 6 && !strcmp(argv[1], "rampthreads")))) {
@@ -399,6 +400,6 @@ int main(int argc, char **argv)
         return 0;
     }
     fprintf(stderr, "usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION | ramp RULE | rampthreads RULE TX TY THREADS"
-                    " | tworamp3 VERSION | floor N DIM | stream DIM RADIUS N STEPS [VERSION] | mesh square|sphere RADIUS | meshstream N | meshfile FILE RADIUS\n");
+                    " | tworamp3 VERSION | floor N DIM | stream DIM RADIUS N STEPS [VERSION [INHIBITION]] | mesh square|sphere RADIUS | meshstream N | meshfile FILE RADIUS\n");
     return 2;
 }

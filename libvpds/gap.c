@@ -67,6 +67,7 @@ static int solve(int m, double a[D][D], double *b, double *x)
 
 typedef struct {
     int d, n;
+    unsigned faces;      /* the faces a vertex may lie on: bit 2k low side of axis k, 2k + 1 high */
     const double *h;     /* half sides; coordinates are relative to the box centre */
     const double *q;     /* the points, D apart */
     double best, y[D];
@@ -81,26 +82,37 @@ static void consider(gap_search *g, const double *y)
     }
 }
 
-/* The vertices of the bisectors of the points in s (m of them, rows = m - 1) with the faces
- * fixing every axis outside `free_axes`, each at its low or high side. */
-static void vertices(gap_search *g, const int *s, int m, unsigned free_axes)
+/* The bisectors of s[0] with s[1..m-1]: rows A y = b (|y - s0|^2 = |y - s_r|^2). */
+static void bisectors(const gap_search *g, const int *s, int m, double A[D][D], double *b)
 {
-    int d = g->d, rows = m - 1, r, k, fixed = d - rows;
-    unsigned side;
-    double A[D][D], b[D];
-    for (r = 0; r < rows; r++) {
+    int r, k;
+    for (r = 0; r < m - 1; r++) {
         const double *a0 = g->q + s[0] * D, *a1 = g->q + s[r + 1] * D;
         b[r] = 0;
-        for (k = 0; k < d; k++) {
+        for (k = 0; k < g->d; k++) {
             A[r][k] = 2 * (a1[k] - a0[k]);
             b[r] += a1[k] * a1[k] - a0[k] * a0[k];
         }
     }
+}
+
+/* The vertices of m points' bisectors (A, b) with the faces fixing every axis outside
+ * `free_axes`, each at its low or high side (of those allowed). */
+static void vertices(gap_search *g, int m, unsigned free_axes, double A[D][D], const double *b)
+{
+    int d = g->d, rows = m - 1, r, k, fixed = d - rows;
+    unsigned side;
     for (side = 0; side < (1u << fixed); side++) {
         double M[D][D], rhs[D], x[D], y[D];
         int j = 0, c, ok = 1;
-        for (k = 0; k < d; k++)
-            if (!(free_axes >> k & 1u)) y[k] = side >> j++ & 1u ? g->h[k] : -g->h[k];
+        for (k = 0; k < d && ok; k++) {
+            unsigned high;
+            if (free_axes >> k & 1u) continue;
+            high = side >> j++ & 1u;
+            ok = g->faces >> (2 * k + high) & 1u;
+            y[k] = high ? g->h[k] : -g->h[k];
+        }
+        if (!ok) continue;
         for (r = 0; r < rows; r++) {
             rhs[r] = b[r];
             for (k = 0, c = 0; k < d; k++) {
@@ -127,12 +139,13 @@ static int popcount(unsigned v)
     return c;
 }
 
-double vpdsi_gap_max(int d, const double *lo, const double *hi, const double *p, int n, double *y)
+double vpdsi_gap_max(int d, const double *lo, const double *hi, unsigned faces, const double *p,
+                     int n, double *y)
 {
-    double c[D], h[D], q[VPDSI_GAP_MAX_POINTS * D];
+    double c[D], h[D], q[VPDSI_GAP_MAX_POINTS * D], A[D][D] = {{0}}, b[D] = {0};
     gap_search g;
     unsigned mask, axes;
-    int i, k;
+    int i, k, usable[1 << D], any[D + 2] = {0};
     for (k = 0; k < d; k++) {
         c[k] = 0.5 * (lo[k] + hi[k]);
         h[k] = 0.5 * (hi[k] - lo[k]);
@@ -141,19 +154,29 @@ double vpdsi_gap_max(int d, const double *lo, const double *hi, const double *p,
         for (k = 0; k < d; k++) q[i * D + k] = p[i * d + k] - c[k];
     g.d = d;
     g.n = n;
+    g.faces = faces;
     g.h = h;
     g.q = q;
     g.best = -1;
     memset(g.y, 0, sizeof g.y);
+    /* the free axes of a vertex: each other axis needs an allowed face; most pieces of a
+     * search have none, and only the interior vertices (m = d + 1) remain */
+    for (axes = 0; axes < (1u << d); axes++) {
+        usable[axes] = 1;
+        for (k = 0; k < d; k++)
+            if (!(axes >> k & 1u) && !(faces >> (2 * k) & 3u)) usable[axes] = 0;
+        if (usable[axes]) any[popcount(axes) + 1] = 1;
+    }
     /* subsets of one point: the box's corners (its distance is convex, largest at a corner) */
-    vertices(&g, (const int[1]){0}, 1, 0u);
+    if (usable[0]) vertices(&g, 1, 0u, A, b);
     for (mask = 1; mask < (1u << n); mask++) {
         int s[D + 1], m = popcount(mask);
-        if (m < 2 || m > d + 1) continue;
+        if (m < 2 || m > d + 1 || !any[m]) continue;
         for (i = 0, k = 0; i < n; i++)
             if (mask >> i & 1u) s[k++] = i;
+        bisectors(&g, s, m, A, b);
         for (axes = 0; axes < (1u << d); axes++)
-            if (popcount(axes) == m - 1) vertices(&g, s, m, axes);
+            if (usable[axes] && popcount(axes) == m - 1) vertices(&g, m, axes, A, b);
     }
     for (k = 0; k < d; k++) {
         double v = c[k] + g.y[k];

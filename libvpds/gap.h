@@ -6,10 +6,18 @@
 #define VPDSI_GAP_MAX_DIM 4    /* the vertex enumeration grows as C(n, d + 1) 2^d: small d only */
 #define VPDSI_GAP_MAX_POINTS 10 /* points one enumeration takes */
 
-/* The squared largest gap, and its maximiser in y; p holds n points of dim coordinates (n >= 1,
- * n <= VPDSI_GAP_MAX_POINTS, dim <= VPDSI_GAP_MAX_DIM), anywhere in space (no torus: the caller
- * passes the images that matter). */
-double vpdsi_gap_max(int dim, const double *lo, const double *hi, const double *p, int n, double *y);
+/* Faces argument of vpdsi_gap_max: every face of the box. */
+#define VPDSI_GAP_ALL_FACES(dim) ((1u << (2 * (dim))) - 1u)
+
+/* The squared largest gap over the box, and its maximiser in y; p holds n points of dim
+ * coordinates (n >= 1, n <= VPDSI_GAP_MAX_POINTS, dim <= VPDSI_GAP_MAX_DIM), anywhere in space
+ * (no torus: the caller passes the images that matter). faces (bit 2k: the low side of axis k,
+ * 2k + 1 the high one) are those the maximiser may lie on: with a subset (a piece of a larger
+ * box, its faces shared with that box), the answer is the largest gap among the points of the
+ * box that are inside or on those faces, -1 when there is none; the larger box's maximum, when
+ * it lies in this piece, is found. */
+double vpdsi_gap_max(int dim, const double *lo, const double *hi, unsigned faces, const double *p,
+                     int n, double *y);
 
 /* Whether p_j is nowhere in the box nearer than p_i: |y - p_i| < |y - p_j| for every y in it
  * (the difference of squares is linear in y, so its largest value over the box is per axis). */

@@ -1,6 +1,8 @@
 /* Branch and bound for the largest gap of a box (gap_search.h): a box keeps only the points that
  * may be nearest somewhere in it; with few left, their vertices give its maximum (gap.c), else
- * it splits in 2^d. A box whose every point lies within the best gap of some point is skipped. */
+ * it splits in 2^d. A box whose every point lies within the best gap of some point is skipped.
+ * The maximum is a vertex of bisectors and the outer box's faces, never of a cut between two
+ * pieces: a piece enumerates only the outer faces it keeps (most pieces none). */
 #include "gap_search.h"
 #include <math.h>
 #include <string.h>
@@ -68,20 +70,20 @@ static int filter(const gap_box_search *q, const int32_t *in, int n_in, const do
 
 /* The largest squared gap over the box into q (its reach2 given); 0 when the depth runs out.
  * The children go in order of their reach, largest first, so that a good best comes early. */
-static int search_box(gap_box_search *q, const double *lo, const double *hi, double reach2,
-                      int depth, int n_in)
+static int search_box(gap_box_search *q, const double *lo, const double *hi, unsigned faces,
+                      double reach2, int depth, int n_in)
 {
     int d = q->d, n, i, k, order[1 << D];
     int32_t *in = q->lists + (size_t)depth * q->n, *out = in + q->n;
     double pts[VPDSI_GAP_MAX_POINTS * D], y[D], clo[1 << D][D], chi[1 << D][D], key[1 << D];
-    unsigned b, nb = 1u << d;
+    unsigned b, nb = 1u << d, kid_faces[1 << D];
     if (reach2 <= q->best) return 1; /* no point of the box beats the best */
     n = filter(q, in, n_in, lo, hi, reach2, out);
     /* the last depth takes as many points as one enumeration can */
     if (n <= points_per_box(d) || (depth + 1 == VPDSI_GAP_SEARCH_DEPTH && n <= VPDSI_GAP_MAX_POINTS)) {
         double v;
         for (i = 0; i < n; i++) memcpy(pts + i * d, q->p + (size_t)out[i] * d, (size_t)d * sizeof(double));
-        v = vpdsi_gap_max(d, lo, hi, pts, n, y);
+        v = vpdsi_gap_max(d, lo, hi, faces, pts, n, y);
         if (v > q->best) {
             q->best = v;
             memcpy(q->y, y, (size_t)d * sizeof(double));
@@ -90,10 +92,14 @@ static int search_box(gap_box_search *q, const double *lo, const double *hi, dou
     }
     if (depth + 1 == VPDSI_GAP_SEARCH_DEPTH) return 0;
     for (b = 0; b < nb; b++) {
+        kid_faces[b] = 0;
         for (k = 0; k < d; k++) {
+            /* a child keeps the outer faces on its side of each axis: the low half the low one */
+            unsigned high = b >> k & 1u;
             double mid = 0.5 * (lo[k] + hi[k]);
-            clo[b][k] = b >> k & 1u ? mid : lo[k];
-            chi[b][k] = b >> k & 1u ? hi[k] : mid;
+            clo[b][k] = high ? mid : lo[k];
+            chi[b][k] = high ? hi[k] : mid;
+            kid_faces[b] |= faces & (1u << (2 * k + high));
         }
         key[b] = reach2_of(q, out, n, clo[b], chi[b]);
         /* insertion into order by key, largest first */
@@ -101,7 +107,9 @@ static int search_box(gap_box_search *q, const double *lo, const double *hi, dou
         order[i] = (int)b;
     }
     for (b = 0; b < nb; b++)
-        if (!search_box(q, clo[order[b]], chi[order[b]], key[order[b]], depth + 1, n)) return 0;
+        if (!search_box(q, clo[order[b]], chi[order[b]], kid_faces[order[b]], key[order[b]], depth + 1,
+                        n))
+            return 0;
     return 1;
 }
 
@@ -117,7 +125,9 @@ int vpdsi_gap_search(int dim, const double *lo, const double *hi, const double *
     q.lists = scratch;
     q.best = -1;
     for (i = 0; i < n; i++) scratch[i] = i;
-    if (!search_box(&q, lo, hi, reach2_of(&q, scratch, n, lo, hi), 0, n) || q.best < 0) return 0;
+    if (!search_box(&q, lo, hi, VPDSI_GAP_ALL_FACES(dim), reach2_of(&q, scratch, n, lo, hi), 0, n) ||
+        q.best < 0)
+        return 0;
     *best = q.best;
     memcpy(y, q.y, (size_t)dim * sizeof(double));
     return 1;

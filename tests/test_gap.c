@@ -43,7 +43,7 @@ static void check_gap_once(int d, int n, int probes)
     }
     for (i = 0; i < n; i++)
         for (k = 0; k < d; k++) p[i * d + k] = lo[k] - 0.5 + unit() * (hi[k] - lo[k] + 1);
-    v = vpdsi_gap_max(d, lo, hi, p, n, y);
+    v = vpdsi_gap_max(d, lo, hi, VPDSI_GAP_ALL_FACES(d), p, n, y);
     for (k = 0; k < d; k++) inside &= y[k] >= lo[k] && y[k] <= hi[k];
     CHECK(inside);
     CHECK_MSG(fabs(nearest2(d, p, n, y) - v) <= 1e-12 * v, "d %d n %d: gap at y %.17g, reported %.17g",
@@ -61,6 +61,31 @@ static void check_gap_once(int d, int n, int probes)
     }
     CHECK_MSG(top <= v * (1 + 1e-12), "d %d n %d: a probe's gap %.17g beats the maximum %.17g", d, n,
               top, v);
+    {
+        /* the box cut in 2^d pieces, each with the outer faces it keeps: no piece beats the
+         * maximum, and the pieces holding its maximiser find it */
+        unsigned b;
+        double found = -1;
+        for (b = 0; b < (1u << d); b++) {
+            double plo[4], phi[4], py[4], pv;
+            unsigned faces = 0;
+            int holds = 1;
+            for (k = 0; k < d; k++) {
+                double mid = 0.5 * (lo[k] + hi[k]);
+                unsigned high = b >> k & 1u;
+                plo[k] = high ? mid : lo[k];
+                phi[k] = high ? hi[k] : mid;
+                faces |= 1u << (2 * k + high);
+                holds &= y[k] >= plo[k] && y[k] <= phi[k];
+            }
+            pv = vpdsi_gap_max(d, plo, phi, faces, p, n, py);
+            CHECK(pv <= v * (1 + 1e-12));
+            if (pv >= 0) CHECK(fabs(nearest2(d, p, n, py) - pv) <= 1e-12 * pv);
+            if (holds && pv > found) found = pv;
+        }
+        CHECK_MSG(fabs(found - v) <= 1e-12 * v, "d %d n %d: pieces found %.17g, the box %.17g", d, n,
+                  found, v);
+    }
 }
 
 /* Known answers: a lone point's farthest corner; a triangle's circumcentre. */
@@ -68,15 +93,15 @@ static void check_gap_known(void)
 {
     double lo[2] = {0, 0}, hi[2] = {1, 1}, y[2], v;
     double one[2] = {0.25, 0.5}, tri[6] = {0.3, 0.3, 0.7, 0.3, 0.5, 0.7};
-    v = vpdsi_gap_max(2, lo, hi, one, 1, y);
+    v = vpdsi_gap_max(2, lo, hi, VPDSI_GAP_ALL_FACES(2), one, 1, y);
     CHECK(y[0] == 1 && (y[1] == 0 || y[1] == 1) && fabs(v - (0.75 * 0.75 + 0.25)) < 1e-15);
     /* the circumcentre (0.5, 0.45) is inside, but the corners are farther from all three */
-    v = vpdsi_gap_max(2, lo, hi, tri, 3, y);
+    v = vpdsi_gap_max(2, lo, hi, VPDSI_GAP_ALL_FACES(2), tri, 3, y);
     CHECK(fabs(v - 0.34) < 1e-14 && y[1] == 1);
     {
         /* a small box around the circumcentre: there it is the maximum */
         double l2[2] = {0.45, 0.4}, h2[2] = {0.55, 0.5};
-        v = vpdsi_gap_max(2, l2, h2, tri, 3, y);
+        v = vpdsi_gap_max(2, l2, h2, VPDSI_GAP_ALL_FACES(2), tri, 3, y);
         CHECK(fabs(y[0] - 0.5) < 1e-15 && fabs(y[1] - 0.45) < 1e-15 && fabs(v - 0.0625) < 1e-15);
     }
 }
