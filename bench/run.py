@@ -178,10 +178,28 @@ def thread_rows(row) -> None:
                 note=f"speed-up over one vpds_run ({n:,d} samples in {sec:.2f} s): {sec / ts:.2f}x")
 
 
+def fps_peer(dim: int, n: int) -> str:
+    """The PyPI package fpsample (QuickFPS: bucket farthest-point sampling over a kd-tree, Rust)
+    picking n points from a cloud of 10 n uniform candidates: what users reach for instead of a
+    continuous farthest-point stream (its farthest points are the cloud's, not the box's)."""
+    try:
+        sh([sys.executable, "-m", "pip", "install", "-q", "--disable-pip-version-check",
+            "--only-binary=:all:", "fpsample>=0.3"])
+        import fpsample  # type: ignore[import-not-found]
+        import numpy as np
+    except Exception as e:  # noqa: BLE001
+        return f"fpsample unavailable: {e}"
+    cloud = np.random.default_rng(1).random((10 * n, dim))
+    start = time.perf_counter()
+    fpsample.bucket_fps_kdline_sampling(cloud, n, h=7, start_idx=0)
+    sec = time.perf_counter() - start
+    return f"fpsample bucket FPS ({n:,d} of {10 * n:,d} candidates): {sec:.2f} s, {n / sec:,.0f} samples/s"
+
+
 def stream_rows() -> None:
     """The continuous stream (vpds_next) from empty: samples/s and the per-sample cost along n,
-    beside a maximal run of about as many samples (no registry package streams a continuous
-    farthest-point order, so the run is the reference)."""
+    beside a maximal run of about as many samples and beside a farthest-point sampler of a
+    candidate cloud from PyPI (no registry package streams a continuous farthest-point order)."""
     for dim, n_total in ((2, 1e4 if QUICK else 1e5), (3, 3e3 if QUICK else 1e5)):
         steps = 10
         lines = sh([str(OUT / "bench"), "stream", str(dim), "1", f"{n_total:g}", str(steps)])
@@ -196,6 +214,7 @@ def stream_rows() -> None:
               f"(stream/run time per sample {(total / n) / (rsec / rn):.1f}x)", flush=True)
         print("   us/sample per tenth of the stream: " + " ".join(f"{c:.0f}" for c in costs),
               flush=True)
+        print("   beside " + fps_peer(dim, n), flush=True)
 
 
 if __name__ == "__main__":

@@ -350,15 +350,15 @@ static int exact_applies(const vpdsi_ctx *ctx)
 
 #define EXACT_MAX_IMAGES 4096 /* candidate images one region takes; past it, the search */
 
-/* The images of sample x within R of the centre along every axis: their count (0 when more
- * than `room`), written d apart to out. Several per sample when a periodic axis is short. */
-static size_t images_near(const vpdsi_problem *pb, const double *x, const double *centre, double R,
-                          double *out, size_t room)
+/* The images of sample x within R of the centre along every axis: on each axis `count` shifts
+ * by the period from `first` (one on an open axis, several when a periodic axis is short);
+ * their number, or 0 when it passes `room`. */
+static size_t image_range(const vpdsi_problem *pb, const double *x, const double *centre, double R,
+                          size_t room, long *first, long *count)
 {
-    long first[VPDS_MAX_DIM], count[VPDS_MAX_DIM], m[VPDS_MAX_DIM];
-    size_t total = 1, i;
-    int d = pb->dim, k;
-    for (k = 0; k < d; k++) {
+    size_t total = 1;
+    int k;
+    for (k = 0; k < pb->dim; k++) {
         double P = pb->period[k];
         first[k] = 0;
         count[k] = 1;
@@ -369,13 +369,21 @@ static size_t images_near(const vpdsi_problem *pb, const double *x, const double
         }
         if ((double)total * (double)count[k] > (double)room) return 0;
         total *= (size_t)count[k];
-        m[k] = 0;
-    }
-    for (i = 0; i < total; i++) {
-        for (k = 0; k < d; k++) out[i * (size_t)d + k] = x[k] + pb->period[k] * (double)(first[k] + m[k]);
-        for (k = 0; k < d && ++m[k] == count[k]; k++) m[k] = 0;
     }
     return total;
+}
+
+/* Those images (image_range), d apart. */
+static void write_images(int d, const double *period, const double *x, const long *first,
+                         const long *count, size_t total, double *out)
+{
+    long m[VPDS_MAX_DIM] = {0};
+    size_t i;
+    int k;
+    for (i = 0; i < total; i++) {
+        for (k = 0; k < d; k++) out[i * (size_t)d + k] = x[k] + period[k] * (double)(first[k] + m[k]);
+        for (k = 0; k < d && ++m[k] == count[k]; k++) m[k] = 0;
+    }
 }
 
 /* The region's candidates: the images of every sample that may be nearest somewhere in it (within
@@ -411,25 +419,30 @@ static vpds_status gather_exact(vpdsi_stream *sm, const vpdsi_ctx *ctx, const do
     }
     R = (R + sqrt(h2)) * (1 + 1e-9);
     sm->n_cand = 0;
-    if (vpdsi_kd_radius(&st->tree, &v, centre, R, ctx->mem, &sm->cand, &sm->n_cand, &sm->cap_cand) ||
-        vpdsi_mem_reserve(ctx->mem, (void **)&sm->cand_x, &sm->cap_cand_x,
-                          EXACT_MAX_IMAGES * (size_t)d, sizeof(double)) ||
-        vpdsi_mem_reserve(ctx->mem, (void **)&sm->lists, &sm->cap_lists,
-                          VPDSI_GAP_SCRATCH(EXACT_MAX_IMAGES), sizeof(int32_t))) {
-        vpdsi_store_error(st, "out of memory in the stream's search");
-        return VPDS_ERR_OUT_OF_MEMORY;
-    }
+    if (vpdsi_kd_radius(&st->tree, &v, centre, R, ctx->mem, &sm->cand, &sm->n_cand, &sm->cap_cand))
+        goto oom;
     for (i = 0; i < sm->n_cand; i++) {
+        const double *x = st->x + (size_t)sm->cand[i] * d;
+        long first[VPDS_MAX_DIM], count[VPDS_MAX_DIM];
         size_t got;
         if (st->r[sm->cand[i]] != st->sizing.radius) return VPDS_OK;
-        got = images_near(pb, st->x + (size_t)sm->cand[i] * d, centre, R, sm->cand_x + n * (size_t)d,
-                          EXACT_MAX_IMAGES - n);
+        got = image_range(pb, x, centre, R, EXACT_MAX_IMAGES - n, first, count);
         if (got == 0) return VPDS_OK;
+        if (vpdsi_mem_reserve(ctx->mem, (void **)&sm->cand_x, &sm->cap_cand_x, (n + got) * (size_t)d,
+                              sizeof(double)))
+            goto oom;
+        write_images(d, pb->period, x, first, count, got, sm->cand_x + n * (size_t)d);
         n += got;
     }
+    if (vpdsi_mem_reserve(ctx->mem, (void **)&sm->lists, &sm->cap_lists, VPDSI_GAP_SCRATCH(n),
+                          sizeof(int32_t)))
+        goto oom;
     *n_images = n;
     *usable = 1;
     return VPDS_OK;
+oom:
+    vpdsi_store_error(st, "out of memory in the stream's search");
+    return VPDS_ERR_OUT_OF_MEMORY;
 }
 
 /* The maximum of g over the region exactly (*solved = 1): *bound just above it, y where it is
