@@ -4,6 +4,7 @@
  *        | tworamp3 VERSION (3D two radii R_f = 0.5 R_c, r = 0.03 + 0.12 x0, periodic axes 1 and 2,
  *          rule bigger, at algorithm_version VERSION: a fuzz input's workload)
  *        | annulus RADIUS (a domain) | stream DIM RADIUS N STEPS [VERSION [INHIBITION]] (prints one line per N/STEPS samples: the cost along n)
+ *        | streamramp RULE N STEPS [VERSION] (the same with the ramp r = 0.001 + 0.3 x0 on the unit square)
  *        | threads DIM RADIUS TILES THREADS (vpds_tiling_run of TILES per axis on THREADS threads)
  *        | rampthreads RULE TILES_X TILES_Y THREADS (the ramp's box tiled so, its sizing thread-safe)
  *        | tilestats DIM RADIUS TILES (the speed-up model's inputs: one run, each phase's tile work
@@ -72,9 +73,9 @@ static int stream(vpds_desc *d, size_t n, size_t steps)
         }
         if (i % every == 0 || i == n) {
             double now_s = now();
-            /* name n seconds_total peak_bytes seconds_of_this_interval t */
-            printf("stream %zu %.6f %zu %.6f %.6g\n", i, now_s - t0, vpds_get_stats(s).peak_bytes,
-                   now_s - t_step, t);
+            /* name n seconds_total peak_bytes seconds_of_this_interval t stream_slack */
+            printf("stream %zu %.6f %zu %.6f %.6g %.3g\n", i, now_s - t0, vpds_get_stats(s).peak_bytes,
+                   now_s - t_step, t, vpds_get_stats(s).stream_slack);
             fflush(stdout);
             t_step = now_s;
         }
@@ -351,6 +352,15 @@ int main(int argc, char **argv)
         if (argc >= 8) d.inhibition = atof(argv[7]);
         return stream(&d, (size_t)atof(argv[4]), (size_t)atoi(argv[5]));
     }
+    if (argc >= 5 && !strcmp(argv[1], "streamramp")) {
+        /* the stream with the ramp r = 0.001 + 0.3 x0 on the unit square, one rule */
+        d.sizing = ramp;
+        d.lipschitz = 0.3;
+        d.rule = !strcmp(argv[2], "prior") ? VPDS_RULE_PRIOR : !strcmp(argv[2], "current") ? VPDS_RULE_CURRENT
+                 : !strcmp(argv[2], "bigger") ? VPDS_RULE_BIGGER : VPDS_RULE_SMALLER;
+        if (argc >= 6) d.algorithm_version = (uint32_t)atoi(argv[5]);
+        return stream(&d, (size_t)atof(argv[3]), (size_t)atoi(argv[4]));
+    }
     if (argc >= 3 && (!strcmp(argv[1], "ramp") || (argc >= 6 && !strcmp(argv[1], "rampthreads")))) {
         /* the paper's Figure 1 ramp on a box 400 times taller: about a million samples */
         double lo[2] = {0, 0}, hi[2] = {1, 400};
@@ -400,6 +410,6 @@ int main(int argc, char **argv)
         return 0;
     }
     fprintf(stderr, "usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION | ramp RULE | rampthreads RULE TX TY THREADS"
-                    " | tworamp3 VERSION | floor N DIM | stream DIM RADIUS N STEPS [VERSION [INHIBITION]] | mesh square|sphere RADIUS | meshstream N | meshfile FILE RADIUS\n");
+                    " | tworamp3 VERSION | floor N DIM | stream DIM RADIUS N STEPS [VERSION [INHIBITION]] | streamramp RULE N STEPS [VERSION] | mesh square|sphere RADIUS | meshstream N | meshfile FILE RADIUS\n");
     return 2;
 }

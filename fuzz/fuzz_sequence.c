@@ -59,6 +59,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 FUZZ_ASSERT(t <= prev, "stream t rose: %g after %g", t, prev);
                 prev = t;
             }
+            /* no event's farthest point lies further below its t than the domain's tolerance */
+            FUZZ_ASSERT(vpds_get_stats(s).stream_slack <= VPDS_STREAM_DOMAIN_TOLERANCE * (1 + 1e-9),
+                        "stream slack %g", vpds_get_stats(s).stream_slack);
         } else if (op == 4) {
             size_t n = take_u8(&b) % 4, i;
             double x[4 * VPDS_MAX_DIM], r[4];

@@ -179,7 +179,10 @@ typedef struct vpds_stats {
     double t;                  /* current scale */
     int maximal;               /* non-zero when the last run completed */
     uint64_t domain_calls;     /* points at which the domain function was evaluated */
-    uint64_t reserved[5];
+    double stream_slack;       /* the largest t / g(y) - 1 of the stream's events (vpds_next):
+                                  each event's farthest point y lies at least t / (1 +
+                                  stream_slack) from the samples before it, in scaled distance */
+    uint64_t reserved[4];
 } vpds_stats;
 
 typedef struct vpds_sampler vpds_sampler;

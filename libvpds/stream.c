@@ -253,7 +253,46 @@ typedef struct {
     double best, extra;  /* g at y; the largest bound of boxes no longer searched */
     double *y;
     double tol;
+    int heap;            /* version 5: the open boxes form a max-heap by bound */
 } region_search;
+
+/* Version 5's open boxes: a max-heap by bound (records of 1 + 2d doubles, the bound first).
+ * Versions 1-4 scan a list for the first largest bound: the same boxes are split, in another
+ * order where bounds tie; a flat maximum leaves tens of thousands open, and the scan of each
+ * split was most of such a search's time. */
+static void box_swap(double *a, double *b, size_t w)
+{
+    size_t i;
+    for (i = 0; i < w; i++) {
+        double t = a[i];
+        a[i] = b[i];
+        b[i] = t;
+    }
+}
+
+static void box_sift_up(vpdsi_stream *sm, size_t i)
+{
+    size_t w = 1 + 2 * (size_t)sm->geom.dim;
+    while (i > 0) {
+        size_t p = (i - 1) / 2;
+        if (!(sm->boxes[p * w] < sm->boxes[i * w])) break;
+        box_swap(sm->boxes + p * w, sm->boxes + i * w, w);
+        i = p;
+    }
+}
+
+static void box_sift_down(vpdsi_stream *sm, size_t i)
+{
+    size_t w = 1 + 2 * (size_t)sm->geom.dim, n = sm->n_boxes;
+    for (;;) {
+        size_t l = 2 * i + 1, r = l + 1, m = i;
+        if (l < n && sm->boxes[l * w] > sm->boxes[m * w]) m = l;
+        if (r < n && sm->boxes[r * w] > sm->boxes[m * w]) m = r;
+        if (m == i) return;
+        box_swap(sm->boxes + m * w, sm->boxes + i * w, w);
+        i = m;
+    }
+}
 
 /* Split the open box (centre cb, half sides hb, already halved) into its 2^d children: each
  * may improve the best point; those that may still beat it by more than the tolerance stay
@@ -293,15 +332,20 @@ static vpds_status split_box(vpdsi_stream *sm, const vpdsi_ctx *ctx, region_sear
         r[0] = ubs[j];
         memcpy(r + 1, cs + j * (size_t)d, (size_t)d * sizeof(double));
         memcpy(r + 1 + d, hb, (size_t)d * sizeof(double));
+        if (q->heap) box_sift_up(sm, sm->n_boxes - 1);
     }
     return VPDS_OK;
 }
 
-/* The open box of the largest bound (the open boxes form a small list: a linear scan). */
-static size_t best_box(const vpdsi_stream *sm, double *top)
+/* The open box of the largest bound: the heap's top, or (versions 1-4) the first of a scan. */
+static size_t best_box(const vpdsi_stream *sm, int heap, double *top)
 {
     size_t w = 1 + 2 * (size_t)sm->geom.dim, j, at = 0;
     *top = -1;
+    if (heap) {
+        if (sm->n_boxes > 0) *top = sm->boxes[0];
+        return 0;
+    }
     for (j = 0; j < sm->n_boxes; j++)
         if (sm->boxes[j * w] > *top) {
             *top = sm->boxes[j * w];
@@ -325,8 +369,9 @@ static double box_magnitude(const vpdsi_problem *pb)
 
 static vpds_status search_diverged(const vpdsi_ctx *ctx, const double *centre)
 {
-    /* never seen without a domain; a domain whose boundary the 1-Lipschitz bound cannot
-     * resolve (a sliver the box centres miss) would otherwise keep the search going */
+    /* a domain whose boundary the 1-Lipschitz bound cannot resolve (a sliver the box centres
+     * miss) would otherwise keep the search going; without a domain only a search already at
+     * the domain's tolerance gets here (never seen) */
     char pc[256];
     vpdsi_format_point(pc, sizeof pc, centre, ctx->pb->dim);
     vpdsi_store_error(ctx->st, "vpds_next: the search for the farthest point near (%s) did not "
@@ -484,7 +529,8 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
     size_t w = 1 + 2 * (size_t)d;
     double g1, ub1, mag = box_magnitude(ctx->pb);
     region_search q;
-    long splits;
+    long splits, budget = ctx->pb->algorithm >= 5 && !ctx->dom->fn ? STREAM_SEARCH_BUDGET / 10
+                                                                   : STREAM_SEARCH_BUDGET;
     vpds_status e;
     if (exact_applies(ctx)) {
         int solved;
@@ -495,6 +541,7 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
         }
     }
     q.tol = stream_tolerance(ctx);
+    q.heap = ctx->pb->algorithm >= 5;
     q.extra = -1;
     q.y = y;
     if ((e = eval_boxes(sm, ctx, centre, 1, half, &g1, &ub1)) != VPDS_OK) return e;
@@ -512,8 +559,17 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
     for (splits = 0;; splits++) {
         double top, hb[VPDS_MAX_DIM], cb[VPDS_MAX_DIM], hmax = 0, U;
         size_t at;
-        if (splits == STREAM_SEARCH_BUDGET) return search_diverged(ctx, centre);
-        at = best_box(sm, &top);
+        if (splits == budget) {
+            /* A maximum flat over a wide area (rule current on a radius ramping to zero: the
+             * distance and the radius grow together) costs about 1/eps boxes: the search goes
+             * on at the domain's tolerance (recorded in vpds_stats.stream_slack); version 5
+             * after a tenth of the budget */
+            if (ctx->dom->fn || q.tol >= VPDS_STREAM_DOMAIN_TOLERANCE) return search_diverged(ctx, centre);
+            q.tol = VPDS_STREAM_DOMAIN_TOLERANCE;
+            budget = STREAM_SEARCH_BUDGET;
+            splits = 0;
+        }
+        at = best_box(sm, q.heap, &top);
         U = top;
         if (q.best > U) U = q.best;
         if (q.extra > U) U = q.extra;
@@ -537,6 +593,7 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
         memcpy(hb, sm->boxes + at * w + 1 + d, (size_t)d * sizeof(double));
         memmove(sm->boxes + at * w, sm->boxes + (sm->n_boxes - 1) * w, w * sizeof(double));
         sm->n_boxes--;
+        if (q.heap) box_sift_down(sm, at);
         for (k = 0; k < d; k++) {
             hb[k] *= 0.5;
             if (hb[k] > hmax) hmax = hb[k];
@@ -798,6 +855,8 @@ vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_m
         if (t <= t_min) return VPDS_STREAM_END;
         vpdsi_store_append(st, x, rx, t, 0);
         ctx->stats->accepted++;
+        if (gy > 0 && isfinite(t) && t / gy - 1 > ctx->stats->stream_slack)
+            ctx->stats->stream_slack = t / gy - 1;
         memcpy(x_out, x, (size_t)d * sizeof(double));
         *t_out = t;
         return VPDS_OK;

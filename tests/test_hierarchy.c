@@ -13,6 +13,9 @@
 static int quick;
 
 static double ramp(const double *x, void *u) { (void)u; return 0.02 + 0.03 * x[0]; }
+/* the paper's Figure 1 ramp: near zero at x = 0, where with rule current the distance and the
+ * radius grow together and the largest gap is flat over a wide area */
+static double steep(const double *x, void *u) { (void)u; return 0.001 + 0.3 * x[0]; }
 /* periodic along axis 0 with L = 0.01 * 2 pi */
 static double wave(const double *x, void *u)
 {
@@ -108,12 +111,16 @@ static vpds_sampler *make(const setup *c, double (*sizing)(const double *, void 
     return s;
 }
 
-/* A stream of n samples: t non-increasing, prefixes valid at taus between the samples' t. */
+/* A stream of n samples: t non-increasing, prefixes valid at taus between the samples' t, each
+ * conflict-free to the stream's own slack (vpds_stats.stream_slack): at most the tolerance, 1e-12
+ * where version 5 finds the farthest point exactly, the domain's where a flat maximum made the
+ * search give up its tolerance. */
 static void check_stream(const setup *c, double (*sizing)(const double *, void *), double L,
                          double radius, size_t n)
 {
     vpds_sampler *s = make(c, sizing, L, radius, 7), *twin = make(c, sizing, L, radius, 7);
-    double x[3], t, prev = INFINITY, xt[3], tt;
+    double x[3], t, prev = INFINITY, xt[3], tt, slack;
+    int exact = !sizing && c->dim <= 4; /* version 5's exact farthest point */
     size_t i;
     int q;
     if (quick) n /= 7;
@@ -125,6 +132,8 @@ static void check_stream(const setup *c, double (*sizing)(const double *, void *
         CHECK(i > 0 || isinf(t)); /* the first sample of an empty sampler: t = +inf */
         prev = t;
     }
+    slack = vpds_get_stats(s).stream_slack;
+    CHECK(slack <= (exact ? 2e-12 : sizing == steep ? VPDS_STREAM_DOMAIN_TOLERANCE : VPDS_STREAM_TOLERANCE));
     for (q = 0; q < 6; q++) {
         /* tau just above the t of sample k: the prefix is samples [0, k) */
         size_t k = n / 8 + (size_t)q * (n - n / 8) / 6;
@@ -133,7 +142,7 @@ static void check_stream(const setup *c, double (*sizing)(const double *, void *
         if (k >= n) k = n - 1;
         tau = ts[k] * (1 + 1e-9);
         while (k > 0 && ts[k - 1] < tau) k--;
-        CHECK(conflicts(c, vpds_points(s), vpds_radii(s), k, tau, VPDS_STREAM_TOLERANCE) == 0);
+        CHECK(conflicts(c, vpds_points(s), vpds_radii(s), k, tau, slack) == 0);
         CHECK(gaps(c, vpds_points(s), vpds_radii(s), k, tau, sizing, radius, 3000, 11u + (unsigned)q) == 0);
     }
     vpds_destroy(s);
@@ -224,6 +233,13 @@ int main(void)
         c.rule = rules[q];
         c.inhibition = q % 2 ? 1.0 : 0.6;
         check_stream(&c, ramp, 0.03, 0, 500);
+    }
+    /* the flat maxima of rules current and bigger on the steep ramp (VPDS_ERR_DOMAIN at the
+     * 259th and the 64th event before the search fell back to the domain's tolerance) */
+    c.inhibition = 1;
+    for (q = 1; q < (quick ? 1 : 3); q++) {
+        c.rule = rules[q];
+        check_stream(&c, steep, 0.3, 0, q == 1 ? 300 : 120);
     }
     c.rule = VPDS_RULE_SMALLER; c.periodic = first; c.inhibition = 0.7;
     if (!quick) check_stream(&c, wave, 0.0629, 0, 500);

@@ -636,7 +636,7 @@ class PoissonDisk:
         st = lib.vpds_get_stats(self._sampler("stats"))
         return {k: getattr(st, k) for k in ("darts", "accepted", "levels", "peak_active_cells",
                                              "bytes_held", "peak_bytes", "sizing_calls", "delta",
-                                             "t", "maximal", "domain_calls")}
+                                             "t", "maximal", "domain_calls", "stream_slack")}
 
     @property
     def lipschitz(self) -> float:
