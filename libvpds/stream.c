@@ -522,8 +522,8 @@ static vpds_status exact_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const do
  * tolerance is VPDS_STREAM_DOMAIN_TOLERANCE: on a curved boundary g is often maximal where it
  * varies quadratically along the boundary, so a tolerance eps costs about 1/eps boxes there. */
 static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centre,
-                                 const double *half, double key, double next, double *lb,
-                                 double *bound, double *y, double *gy)
+                                 const double *half, double next, double *lb, double *bound,
+                                 double *y, double *gy)
 {
     int d = ctx->pb->dim, k;
     size_t w = 1 + 2 * (size_t)d;
@@ -532,14 +532,6 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
     long splits, budget = ctx->pb->algorithm >= 5 && !ctx->dom->fn ? STREAM_SEARCH_BUDGET / 10
                                                                    : STREAM_SEARCH_BUDGET;
     vpds_status e;
-    if (exact_applies(ctx)) {
-        int solved;
-        if ((e = exact_region(sm, ctx, centre, half, key, bound, y, gy, &solved)) != VPDS_OK) return e;
-        if (solved) {
-            if (lb && *gy > *lb) *lb = *gy;
-            return VPDS_OK;
-        }
-    }
     q.tol = stream_tolerance(ctx);
     q.heap = ctx->pb->algorithm >= 5;
     q.extra = -1;
@@ -774,7 +766,15 @@ static vpds_status bound_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, double k
             return VPDS_OK;
         }
     }
-    return search_region(sm, ctx, centre, half, key, next, v3 ? lb : NULL, bound, y, gy);
+    if (exact) {
+        int solved;
+        vpds_status e = exact_region(sm, ctx, centre, half, key, bound, y, gy, &solved);
+        if (e != VPDS_OK || solved) {
+            if (e == VPDS_OK && *gy > *lb) *lb = *gy;
+            return e;
+        }
+    }
+    return search_region(sm, ctx, centre, half, next, v3 ? lb : NULL, bound, y, gy);
 }
 
 /* The sample of an event at t that covers y: y itself with one radius, else a point drawn
