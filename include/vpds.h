@@ -48,15 +48,18 @@ extern "C" {
  * learns (cells shown covered, witness points) and a dart asks only about the cells near it;
  * the points of version 3 except where the search's box budget or precision decided. 5: with a
  * constant radius and no domain (dim <= 4) the stream finds the largest gap exactly, at a vertex
- * of the bisectors of the few samples near it, instead of to the tolerance (other points for
- * vpds_next; the runs give the points of version 4). */
+ * of the bisectors of the few samples near it, instead of to the tolerance, and a search to the
+ * tolerance (a variable radius, a domain) keeps its open boxes in a heap, which splits them in
+ * another order where bounds tie (other points for vpds_next; the runs give the points of
+ * version 4). */
 #define VPDS_ALGORITHM_VERSION 5
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 16
 /* Relative tolerance eps of the continuous stream (vpds_next): each t it reports is an upper
  * bound of the scale at which the earlier samples stop being maximal, and the point inserted
  * there is within t * (1 - eps) * inhibition * f of them at worst (exact with two radii when
- * inhibition <= coverage * (1 - eps)). */
+ * inhibition <= coverage * (1 - eps)); where a maximum flat over a wide area made a search go
+ * on at VPDS_STREAM_DOMAIN_TOLERANCE, vpds_stats.stream_slack says so. */
 #define VPDS_STREAM_TOLERANCE 1e-5
 /* The same with a domain (desc.domain set): on a curved boundary the maximum of the gap is flat
  * along the boundary, and a tolerance eps costs about 1/eps search boxes per sample there. */

@@ -13,9 +13,9 @@
  * coordinates (n >= 1, n <= VPDSI_GAP_MAX_POINTS, dim <= VPDSI_GAP_MAX_DIM), anywhere in space
  * (no torus: the caller passes the images that matter). faces (bit 2k: the low side of axis k,
  * 2k + 1 the high one) are those the maximiser may lie on: with a subset (a piece of a larger
- * box, its faces shared with that box), the answer is the largest gap among the points of the
- * box that are inside or on those faces, -1 when there is none; the larger box's maximum, when
- * it lies in this piece, is found. */
+ * box, its faces shared with that box), the answer is the largest gap among the vertices that
+ * use only those faces (-1: none), a lower bound of the piece's; the larger box's maximum, when
+ * it lies in this piece, is among them. */
 double vpdsi_gap_max(int dim, const double *lo, const double *hi, unsigned faces, const double *p,
                      int n, double *y);
 

@@ -408,8 +408,11 @@ static size_t image_range(const vpdsi_problem *pb, const double *x, const double
         first[k] = 0;
         count[k] = 1;
         if (P > 0) {
-            first[k] = (long)ceil((centre[k] - R - x[k]) / P);
-            count[k] = (long)floor((centre[k] + R - x[k]) / P) - first[k] + 1;
+            /* counted in doubles first: a reach of many periods must not overflow a long */
+            double lo_m = ceil((centre[k] - R - x[k]) / P), hi_m = floor((centre[k] + R - x[k]) / P);
+            if (!(hi_m - lo_m + 1 <= (double)room) || !(fabs(lo_m) < 1e15)) return 0;
+            first[k] = (long)lo_m;
+            count[k] = (long)(hi_m - lo_m) + 1;
             if (count[k] < 1) count[k] = 1; /* round-off: the nearest image stays */
         }
         if ((double)total * (double)count[k] > (double)room) return 0;
@@ -510,9 +513,26 @@ static vpds_status exact_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const do
         hi[k] = centre[k] + half[k];
     }
     if (!vpdsi_gap_search(d, lo, hi, sm->cand_x, (int)n_images, sm->lists, &best, y)) return VPDS_OK;
+    {
+        /* g at y as rounded, from the candidates (the nearest sample is one of them): far from
+         * the origin it is below the search's own figure by the coordinates' round-off, which
+         * vpds_stats.stream_slack then shows */
+        double scale = pb->coverage * ctx->st->sizing.radius, near2 = INFINITY;
+        size_t i;
+        for (i = 0; i < n_images; i++) {
+            double e2 = 0;
+            for (k = 0; k < d; k++) {
+                double e = y[k] - sm->cand_x[i * (size_t)d + k];
+                e2 += e * e;
+            }
+            if (e2 < near2) near2 = e2;
+        }
+        *gy = sqrt(near2) / scale;
+        *bound = sqrt(best) / scale;
+        if (*gy > *bound) *bound = *gy;
+        *bound *= 1 + EXACT_ROUNDING;
+    }
     vpdsi_store_wrap(ctx->st, y);
-    *gy = sqrt(best) / (pb->coverage * ctx->st->sizing.radius);
-    *bound = *gy * (1 + EXACT_ROUNDING);
     *solved = 1;
     return VPDS_OK;
 }
@@ -529,8 +549,7 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
     size_t w = 1 + 2 * (size_t)d;
     double g1, ub1, mag = box_magnitude(ctx->pb);
     region_search q;
-    long splits, budget = ctx->pb->algorithm >= 5 && !ctx->dom->fn ? STREAM_SEARCH_BUDGET / 10
-                                                                   : STREAM_SEARCH_BUDGET;
+    long splits, budget = STREAM_SEARCH_BUDGET;
     vpds_status e;
     q.tol = stream_tolerance(ctx);
     q.heap = ctx->pb->algorithm >= 5;
@@ -554,8 +573,7 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
         if (splits == budget) {
             /* A maximum flat over a wide area (rule current on a radius ramping to zero: the
              * distance and the radius grow together) costs about 1/eps boxes: the search goes
-             * on at the domain's tolerance (recorded in vpds_stats.stream_slack); version 5
-             * after a tenth of the budget */
+             * on at the domain's tolerance (recorded in vpds_stats.stream_slack) */
             if (ctx->dom->fn || q.tol >= VPDS_STREAM_DOMAIN_TOLERANCE) return search_diverged(ctx, centre);
             q.tol = VPDS_STREAM_DOMAIN_TOLERANCE;
             budget = STREAM_SEARCH_BUDGET;
@@ -762,6 +780,7 @@ static vpds_status bound_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, double k
         /* (the exact search's g(y) is its own arithmetic's: equal to round-off) */
         if (g1 == *gy || (exact && g1 >= *gy * (1 - EXACT_ROUNDING))) {
             *bound = key;
+            *gy = g1;
             if (v3 && g1 > *lb) *lb = g1;
             return VPDS_OK;
         }

@@ -239,7 +239,7 @@ int main(void)
     c.inhibition = 1;
     for (q = 1; q < (quick ? 1 : 3); q++) {
         c.rule = rules[q];
-        check_stream(&c, steep, 0.3, 0, q == 1 ? 300 : 120);
+        check_stream(&c, steep, 0.3, 0, q == 1 ? 270 : 80);
     }
     c.rule = VPDS_RULE_SMALLER; c.periodic = first; c.inhibition = 0.7;
     if (!quick) check_stream(&c, wave, 0.0629, 0, 500);
