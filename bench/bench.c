@@ -1,7 +1,7 @@
 #define _POSIX_C_SOURCE 199309L
 /* libvpds workloads for `make bench`. Prints "name n seconds peak_bytes" per line.
  * usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION [VERSION] | ramp RULE | floor N DIM
- *        | tworamp3 VERSION (3D two radii R_f = 0.5 R_c, r = 0.03 + 0.12 x0, periodic axes 1 and 2,
+ *        | tworamp3 VERSION [INHIBITION] (3D two radii R_f = INHIBITION R_c (0.5), r = 0.03 + 0.12 x0, periodic axes 1 and 2,
  *          rule bigger, at algorithm_version VERSION: a fuzz input's workload)
  *        | annulus RADIUS (a domain) | stream DIM RADIUS N STEPS [VERSION [INHIBITION]] (prints one line per N/STEPS samples: the cost along n)
  *        | streamramp RULE N STEPS [VERSION] (the same with the ramp r = 0.001 + 0.3 x0 on the unit square)
@@ -320,7 +320,7 @@ int main(int argc, char **argv)
         d.dim = 3;
         d.sizing = ramp3;
         d.lipschitz = 0.12;
-        d.inhibition = 0.5;
+        d.inhibition = argc >= 4 ? atof(argv[3]) : 0.5;
         d.rule = VPDS_RULE_BIGGER;
         d.periodic = periodic;
         d.algorithm_version = (uint32_t)atoi(argv[2]);

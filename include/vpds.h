@@ -51,8 +51,10 @@ extern "C" {
  * of the bisectors of the few samples near it, instead of to the tolerance, and a search to the
  * tolerance (a variable radius, a domain) keeps its open boxes in a heap, which splits them in
  * another order where bounds tie (other points for vpds_next; the runs give the points of
- * version 4). */
-#define VPDS_ALGORITHM_VERSION 5
+ * version 4). 6: with two radii each cell a dart asks about keeps which of its sub-boxes its
+ * searches showed covered, and later questions and the sweep skip them (other points with two
+ * radii, where the search's box budget decided). */
+#define VPDS_ALGORITHM_VERSION 6
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 16
 /* Relative tolerance eps of the continuous stream (vpds_next): each t it reports is an upper

@@ -323,6 +323,31 @@ double vpdsi_kd_min_ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, cons
     return best;
 }
 
+int vpdsi_kd_ratio_within(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *y,
+                          double bound)
+{
+    int32_t stack[STACK_MAX];
+    int top = 0;
+    if (t->n_nodes == 0) return 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        int32_t n = stack[--top];
+        const vpdsi_kd_node *nd = &t->nodes[n];
+        /* every sample of the node has a ratio of at least its box distance over rmax */
+        if (!(sqrt(vpdsi_box_mindist2(t, y, BOX_LO(t, n), BOX_HI(t, n))) <= bound * nd->rmax)) continue;
+        if (nd->left < 0) {
+            int32_t i;
+            for (i = nd->head; i >= 0; i = t->next[i])
+                if (ratio(t, s, i, y, 0.0, 0.0, (int)VPDS_RULE_PRIOR) <= bound) return 1;
+        } else {
+            int near = y[nd->axis] < nd->split;
+            stack[top++] = near ? nd->right : nd->left;
+            stack[top++] = near ? nd->left : nd->right;
+        }
+    }
+    return 0;
+}
+
 /* ---- Candidate lists: the same tests over a list of sample indices instead of the tree ---- */
 
 /* Gap between the intervals [a, b] and [lo, hi] along an axis of period P (0: open). */

@@ -71,6 +71,10 @@ int vpdsi_kd_box_covered(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const
  * (|y - x| + slack) / f(r(x), ry) over all samples, with its index in *arg (-1: no sample, the
  * result is +INFINITY). With slack = 0 and ry = r(y) this is g(y) * coverage; with slack the
  * half-diagonal of a box around y and ry a lower bound of r there, it bounds g over the box. */
+/* Whether vpdsi_kd_min_ratio(t, s, y, 0, ry, VPDS_RULE_PRIOR) <= bound, stopping at the first
+ * sample that shows it (same bits: the two compute each sample's ratio alike). */
+int vpdsi_kd_ratio_within(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *y,
+                          double bound);
 double vpdsi_kd_min_ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *y,
                           double slack, double ry, int rule, int32_t *arg);
 

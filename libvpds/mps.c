@@ -310,7 +310,7 @@ static vpds_status judge_dart(vpdsi_mps *m, const vpdsi_ctx *ctx, const double *
     }
     if (pb->two_radii) {
         /* no cell that may hold an uncovered point within reach: nothing new to cover */
-        if (vpdsi_uncovered_nearest(&m->unc, y) > coverage_reach(m, ctx, ry) + m->unc.half)
+        if (!vpdsi_uncovered_near(&m->unc, y, coverage_reach(m, ctx, ry) + m->unc.half))
             return VPDS_OK;
         if (pb->algorithm >= 4) return vpdsi_uncovered_dart(&m->unc, ctx, m->run.t, y, ry, accept);
         return vpdsi_uncovered_in(&m->unc, ctx, m->run.t, y, y, ry, accept);
@@ -623,6 +623,9 @@ static vpds_status flag_uncovered(vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned l
         vpdsi_search_out out;
         flag[b] = 0;
         if (bit_set(covered, b) || bit_set(cov_c, b)) continue;
+        /* version 6: the darts' questions showed it covered */
+        if (vpdsi_uncovered_child_covered(&m->unc, m->run.pos, d, split, (unsigned)child_number(block, b)))
+            continue;
         child_coords(d, c, child_number(block, b), split, cc);
         vpdsi_lattice_box(&m->run.geom, split ? level + 1 : level, cc, clo, chi);
         if (pw && point_in_box(d, pw, clo, chi)) { /* still uncovered, so this child is flagged */
@@ -758,7 +761,9 @@ static vpds_status vfilter_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
     size_t j;
     vpds_status e;
     if (!m->unc.ready && (e = vpdsi_uncovered_index(&m->unc, st, &m->run.next, &m->run.geom,
-                                                       ctx->pb->algorithm >= 4)) != VPDS_OK)
+                                                       ctx->pb->algorithm >= 6   ? 2
+                                                       : ctx->pb->algorithm >= 4 ? 1
+                                                                                 : 0)) != VPDS_OK)
         return e;
     if (varying) {
         if ((e = reserve_buffers(m, ctx, n)) != VPDS_OK) return e;
@@ -775,7 +780,7 @@ static vpds_status vfilter_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
         double h = 0.5 * sqrt(vpdsi_lattice_box(&m->run.geom, run->next.level, (vpdsi_cells_get(&run->next, i, d, c), c), lo, hi));
         double r_hi = varying ? m->buf_r[j] + st->sizing.lipschitz * h : st->sizing.radius;
         for (k = 0; k < d; k++) centre[k] = 0.5 * (lo[k] + hi[k]);
-        if (vpdsi_uncovered_nearest(&m->unc, centre) <= coverage_reach(m, ctx, r_hi) + h + m->unc.half) {
+        if (vpdsi_uncovered_near(&m->unc, centre, coverage_reach(m, ctx, r_hi) + h + m->unc.half)) {
             vpdsi_cells_move(&run->next, i, (size_t)run->wpos);
             vpdsi_uncovered_move(&m->unc, i, (size_t)run->wpos);
             run->wpos++;

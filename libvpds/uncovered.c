@@ -39,6 +39,10 @@ typedef struct {
     size_t budget;    /* boxes this search may examine */
     double *witness;  /* where the uncovered point found goes (dim coordinates, then r there) */
     int found_point;  /* *found came from such a point, not from the budget or the precision */
+    int drop_kept;    /* the box examined last was dropped for good: inside one coverage disk
+                         or outside the domain (not for missing this question's region) */
+    uint64_t *sub;    /* version 6: the cell's sub-boxes shown covered (vpdsi_search_out.sub) */
+    int sub_depth;
     vpdsi_kd_samples view, uview;
     bb_lists lv[UNCOVERED_DEPTH + 1];
     /* the box being examined: kept here, not in the helpers' frames, which then cost nothing
@@ -53,16 +57,15 @@ static size_t slot(int depth, int samples)
     return ((size_t)depth * 2 + (size_t)samples) * LIST_CAP;
 }
 
-double vpdsi_uncovered_nearest(const vpdsi_uncovered *u, const double *p)
+int vpdsi_uncovered_near(const vpdsi_uncovered *u, const double *p, double thr)
 {
     vpdsi_kd_samples v = vpdsi_uncovered_view(u);
-    int32_t arg;
-    if (!u->ready) return 0.0;
-    return vpdsi_kd_min_ratio(&u->tree, &v, p, 0.0, 1.0, (int)VPDS_RULE_PRIOR, &arg);
+    if (!u->ready) return 1;
+    return vpdsi_kd_ratio_within(&u->tree, &v, p, thr);
 }
 
 /* Whether a cell that may hold an uncovered point lies within thr of c2: exactly
- * vpdsi_uncovered_nearest(q->u, c2) <= thr, read from this box's list of centres when complete. */
+ * vpdsi_uncovered_near(q->u, c2, thr), read from this box's list of centres when complete. */
 static int near_uncovered(bb_search *q, int depth, const double *c2, double thr)
 {
     bb_lists *me = &q->lv[depth];
@@ -79,7 +82,7 @@ static int near_uncovered(bb_search *q, int depth, const double *c2, double thr)
         me->u_n = q->count - off;
         me->u_ok = 1;
     }
-    if (!me->u_ok) return !(vpdsi_uncovered_nearest(q->u, c2) > thr);
+    if (!me->u_ok) return vpdsi_uncovered_near(q->u, c2, thr);
     return !(vpdsi_kd_list_min_ratio(&q->u->tree, &q->uview, q->u->lists + off, me->u_n, c2, 0.0, 1.0,
                                      (int)VPDS_RULE_PRIOR) > thr);
 }
@@ -157,6 +160,7 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
     double *p = q->p, *c2 = q->c2, gap2 = 0, diag2 = 0, diag, r_lo, r_hi;
     vpds_status st;
     *verdict = 0;
+    q->drop_kept = 0;
     q->lv[depth].u_ok = q->lv[depth].s_ok = 0;
     for (k = 0; k < d; k++) {
         /* nearest point of the box to the anchor's centre, and the box-anchor gap */
@@ -174,7 +178,10 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
     /* the box lies outside the domain: nothing there needs covering */
     if (q->dom->fn) {
         if ((st = vpdsi_domain_at(q->dom, q->st, c2, &q->phi)) != VPDS_OK) return st;
-        if (q->phi > 0.5 * sqrt(diag2)) return VPDS_OK;
+        if (q->phi > 0.5 * sqrt(diag2)) {
+            q->drop_kept = 1;
+            return VPDS_OK;
+        }
     }
     if (q->st->sizing.kind == VPDSI_SIZING_CONSTANT)
         q->rp = q->st->sizing.radius; /* what vpdsi_radius_at answers, without its frame */
@@ -223,6 +230,7 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
     if ((st = search_box_covered(q, depth, lo, hi, r_lo, r_hi, verdict)) != VPDS_OK) return st;
     if (*verdict) { /* inside one coverage disk */
         *verdict = 0;
+        q->drop_kept = 1;
         return VPDS_OK;
     }
     /* unresolved at the precision: count it as uncovered */
@@ -262,52 +270,101 @@ static void first_box(bb_search *q, double *bx)
     bx[2 * d] = 0;
 }
 
+/* Version 6: the bits of q->sub of the box at `depth` whose first sub-box at q->sub_depth is
+ * `first` (its sub-boxes are consecutive: the first halving is the most significant). */
+static uint64_t sub_bits(const bb_search *q, int depth, unsigned first)
+{
+    unsigned n = 1u << ((unsigned)q->pb->dim * (unsigned)(q->sub_depth - depth));
+    return (n >= 64 ? ~UINT64_C(0) : (UINT64_C(1) << n) - 1) << first;
+}
+
+/* A frame of the search's stack: the box (dim lows, dim highs), its depth, how many of its 2^d
+ * children are still to visit (-1: the box itself is not examined yet), its first sub-box of
+ * q->sub (version 6) and whether every box below it was dropped for good so far. */
+#define FRAME_DEPTH(f, d) (f)[2 * (d)]
+#define FRAME_LEFT(f, d) (f)[2 * (d) + 1]
+#define FRAME_SUB(f, d) (f)[2 * (d) + 2]
+#define FRAME_KEPT(f, d) (f)[2 * (d) + 3]
+#define FRAME_DOUBLES(d) (2 * (size_t)(d) + 4)
+
+/* Examines the box of frame bx (or skips it, its sub-boxes known covered); *verdict as examine. */
+static vpds_status visit(bb_search *q, double *bx, size_t *boxes, int *found, int *verdict)
+{
+    int d = q->pb->dim, depth = (int)FRAME_DEPTH(bx, d);
+    unsigned first = (unsigned)FRAME_SUB(bx, d);
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
+    if (q->sub && depth <= q->sub_depth) {
+        uint64_t bits = sub_bits(q, depth, first);
+        if ((*q->sub & bits) == bits) { /* shown covered by an earlier question of this scale */
+            *verdict = 0;
+            q->drop_kept = 1;
+            return VPDS_OK;
+        }
+    }
+    memcpy(lo, bx, (size_t)d * sizeof(double));
+    memcpy(hi, bx + d, (size_t)d * sizeof(double));
+    q->u->boxes++;
+    if (++*boxes > q->budget) {
+        *found = 1;
+        return VPDS_OK;
+    }
+    return examine(q, lo, hi, depth, verdict);
+}
+
+/* A frame done: what it showed covered goes into q->sub and up to its parent. */
+static void frame_done(bb_search *q, double *bx, double *parent)
+{
+    int d = q->pb->dim, depth = (int)FRAME_DEPTH(bx, d);
+    if (FRAME_KEPT(bx, d) == 0) {
+        if (parent) FRAME_KEPT(parent, d) = 0;
+    } else if (q->sub && depth <= q->sub_depth) {
+        *q->sub |= sub_bits(q, depth, (unsigned)FRAME_SUB(bx, d));
+    }
+}
+
 /* Depth first over the boxes from the first one: *found at the first "uncovered" verdict, or
- * when the boxes exceed the budget. A frame of the stack is a box (lo, hi, depth) and how many
- * of its 2^d children are still to visit (-1: the box itself is not examined yet); children
- * are made one at a time, the last first, so the stack holds one frame per depth. */
+ * when the boxes exceed the budget. Children are made one at a time, the last first, so the
+ * stack holds one frame per depth. */
 static vpds_status search(bb_search *q, int *found)
 {
     int d = q->pb->dim, k;
-    size_t top = 1, boxes = 0, stride = 2 * (size_t)d + 2;
+    size_t top = 1, boxes = 0, stride = FRAME_DOUBLES(d);
     double *stack = q->u->stack;
     vpds_status st;
-    stack[2 * d + 1] = -1;
+    FRAME_LEFT(stack, d) = -1;
+    FRAME_SUB(stack, d) = 0;
     while (top > 0) {
         double *bx = stack + (top - 1) * stride, *cb, left;
-        int depth = (int)bx[2 * d], verdict;
+        int depth = (int)FRAME_DEPTH(bx, d), verdict;
         unsigned b;
-        if (bx[2 * d + 1] < 0) {
-            double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
-            memcpy(lo, bx, (size_t)d * sizeof(double));
-            memcpy(hi, bx + d, (size_t)d * sizeof(double));
-            q->u->boxes++;
-            if (++boxes > q->budget) {
-                *found = 1;
-                return VPDS_OK;
-            }
-            if ((st = examine(q, lo, hi, depth, &verdict)) != VPDS_OK) return st;
+        if (FRAME_LEFT(bx, d) < 0) {
+            if ((st = visit(q, bx, &boxes, found, &verdict)) != VPDS_OK || *found) return st;
             if (verdict == 1) {
                 *found = 1;
                 return VPDS_OK;
             }
-            bx[2 * d + 1] = verdict == 0 ? 0 : (double)(1u << d);
+            FRAME_LEFT(bx, d) = verdict == 0 ? 0 : (double)(1u << d);
+            FRAME_KEPT(bx, d) = verdict == 0 ? q->drop_kept : 1;
         }
-        left = bx[2 * d + 1];
+        left = FRAME_LEFT(bx, d);
         if (left == 0) {
+            frame_done(q, bx, top > 1 ? bx - stride : NULL);
             top--;
             continue;
         }
         b = (unsigned)left - 1;
-        bx[2 * d + 1] = b;
+        FRAME_LEFT(bx, d) = b;
         cb = stack + top++ * stride;
         for (k = 0; k < d; k++) {
             double mid = 0.5 * (bx[k] + bx[d + k]);
             cb[k] = (b >> k) & 1u ? mid : bx[k];
             cb[d + k] = (b >> k) & 1u ? bx[d + k] : mid;
         }
-        cb[2 * d] = depth + 1;
-        cb[2 * d + 1] = -1;
+        FRAME_DEPTH(cb, d) = depth + 1;
+        FRAME_LEFT(cb, d) = -1;
+        FRAME_SUB(cb, d) = FRAME_SUB(bx, d);
+        if (q->sub && depth < q->sub_depth)
+            FRAME_SUB(cb, d) += (double)(b << ((unsigned)d * (unsigned)(q->sub_depth - depth - 1)));
     }
     return VPDS_OK;
 }
@@ -320,7 +377,7 @@ static vpds_status prepare(bb_search *q, vpdsi_uncovered *u, const vpdsi_ctx *ct
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_store *st = ctx->st;
     int d = pb->dim;
-    size_t stride = 2 * (size_t)d + 2, need;
+    size_t stride = FRAME_DOUBLES(d), need;
     vpds_status e;
     *found = 0;
     memset(q, 0, sizeof *q);
@@ -379,6 +436,10 @@ vpds_status vpdsi_uncovered_in_box(vpdsi_uncovered *u, const vpdsi_ctx *ctx, dou
         if (out->budget < q.budget) q.budget = out->budget;
         q.witness = out->witness;
         q.in_cell = q.in_cell || out->in_indexed;
+        if (cell && out->sub && out->sub_depth > 0) {
+            q.sub = out->sub;
+            q.sub_depth = out->sub_depth;
+        }
     }
     q.slack = list_slack(ctx->pb, u->stack, u->stack + d);
     e = search(&q, found);

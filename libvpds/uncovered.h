@@ -32,6 +32,12 @@ typedef struct vpdsi_uncovered {
     double *nwit; size_t n_nwit, cap_nwit;
     size_t n_centre_of;
     int32_t *cand; size_t cap_cand;    /* the indexed cells near a dart */
+    /* Version 6: per indexed cell, which of its sub-boxes at depth sub_depth of the search's
+     * halving a search showed covered (bit i: the i-th, first halving most significant), so that
+     * the later questions on the cell (about ten per cell, Figure 2's neighbourhoods overlap)
+     * skip them; 0: not kept (sub_depth * dim > 6) */
+    uint64_t *sub; size_t cap_sub;
+    int sub_depth;
     int learn;                         /* the index keeps what is learnt (version 4) */
 } vpdsi_uncovered;
 
@@ -48,6 +54,9 @@ typedef struct vpdsi_search_out {
     int found_point;  /* out: *found came from such a point */
     int in_indexed;   /* in: the anchor box lies in an indexed cell, whose centre is then near
                          every box of the search: the centres' test is skipped (same answers) */
+    uint64_t *sub;    /* in/out (or NULL): the first box is an indexed cell's image and these are
+                         its sub-boxes shown covered (vpdsi_uncovered.sub): skipped, and set */
+    int sub_depth;    /* the depth of those sub-boxes */
 } vpdsi_search_out;
 
 static inline vpdsi_kd_samples vpdsi_uncovered_view(const vpdsi_uncovered *u)
@@ -87,6 +96,9 @@ vpds_status vpdsi_uncovered_parent(vpdsi_uncovered *u, const vpdsi_ctx *ctx, dou
                                    int *state, const double **witness);
 /* Whether active cell `pos` is an indexed cell of a version-4 index (its centre is listed). */
 int vpdsi_uncovered_indexed(const vpdsi_uncovered *u, size_t pos);
+/* Version 6: whether the sub-boxes of active cell `pos` shown covered hold child `child` of it
+ * (bit k: the upper half on axis k; split 0: the cell itself) whole. */
+int vpdsi_uncovered_child_covered(const vpdsi_uncovered *u, size_t pos, int d, int split, unsigned child);
 /* Room for `more` sweep records; one record (witness NULL: none) per flagged cell, in order. */
 int vpdsi_uncovered_reserve_records(vpdsi_uncovered *u, vpdsi_mem *m, int dim, size_t more);
 void vpdsi_uncovered_record(vpdsi_uncovered *u, int dim, const double *witness);
@@ -94,10 +106,10 @@ void vpdsi_uncovered_record(vpdsi_uncovered *u, int dim, const double *witness);
 void vpdsi_uncovered_move(vpdsi_uncovered *u, size_t from, size_t to);
 
 /* Index the centres of the cells `next` (geometry g) flagged in u->flag: every uncovered point
- * lies in one of them, now and after any later sample; with `learn`, keep what is learnt. */
+ * lies in one of them, now and after any later sample; with `learn`, keep what is learnt
+ * (learn 2, version 6: the covered sub-boxes too). */
 vpds_status vpdsi_uncovered_index(vpdsi_uncovered *u, vpdsi_store *st, const vpdsi_cells *next,
                                   const vpdsi_lattice *g, int learn);
-/* Distance from p to the nearest indexed centre (+INFINITY: none; 0 when no index is ready,
- * which answers "maybe" to every question). */
-double vpdsi_uncovered_nearest(const vpdsi_uncovered *u, const double *p);
+/* Whether an indexed centre lies within thr of p (1 when no index is ready: "maybe"). */
+int vpdsi_uncovered_near(const vpdsi_uncovered *u, const double *p, double thr);
 #endif

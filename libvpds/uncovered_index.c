@@ -30,6 +30,10 @@ void vpdsi_uncovered_release(vpdsi_uncovered *u, vpdsi_mem *m)
     vpdsi_mem_free(m, u->state, u->cap_state);
     vpdsi_mem_free(m, u->centre_of, u->cap_centre_of * sizeof(int32_t));
     vpdsi_mem_free(m, u->cand, u->cap_cand * sizeof(int32_t));
+    vpdsi_mem_free(m, u->sub, u->cap_sub * sizeof(uint64_t));
+    u->sub = NULL;
+    u->cap_sub = 0;
+    u->sub_depth = 0;
     u->flag = u->f = u->state = NULL;
     u->x = u->r = u->stack = u->cbox = u->wit = u->nwit = NULL;
     u->lists = u->centre_of = u->cand = NULL;
@@ -39,7 +43,8 @@ void vpdsi_uncovered_release(vpdsi_uncovered *u, vpdsi_mem *m)
     u->ready = u->learn = 0;
 }
 
-/* Room for the m indexed cells of a level of n cells: centres, and with `learn` what is learnt. */
+/* Room for the m indexed cells of a level of n cells: centres, and with `learn` what is learnt
+ * (learn 2: their covered sub-boxes too). */
 static int reserve_index(vpdsi_uncovered *u, vpdsi_mem *mem, int d, size_t m, size_t n, int learn)
 {
     size_t nx, nb, nw;
@@ -53,7 +58,8 @@ static int reserve_index(vpdsi_uncovered *u, vpdsi_mem *mem, int d, size_t m, si
     return vpdsi_mem_reserve(mem, (void **)&u->cbox, &u->cap_cbox, nb, sizeof(double)) ||
            vpdsi_mem_reserve(mem, (void **)&u->state, &u->cap_state, m + 1, 1) ||
            vpdsi_mem_reserve(mem, (void **)&u->centre_of, &u->cap_centre_of, n + 1, sizeof(int32_t)) ||
-           vpdsi_mem_reserve(mem, (void **)&u->nwit, &u->cap_nwit, nw, sizeof(double));
+           vpdsi_mem_reserve(mem, (void **)&u->nwit, &u->cap_nwit, nw, sizeof(double)) ||
+           (learn > 1 && vpdsi_mem_reserve(mem, (void **)&u->sub, &u->cap_sub, m + 1, sizeof(uint64_t)));
 }
 
 vpds_status vpdsi_uncovered_index(vpdsi_uncovered *u, vpdsi_store *st, const vpdsi_cells *next,
@@ -66,7 +72,7 @@ vpds_status vpdsi_uncovered_index(vpdsi_uncovered *u, vpdsi_store *st, const vpd
     u->ready = 0;
     for (i = 0; i < next->count; i++) m += u->flag[i] != 0;
     /* the sweep left one record per flagged cell: they become the cells' witnesses */
-    learn = learn && u->n_nwit == m;
+    learn = u->n_nwit == m ? learn : 0;
     vpdsi_kd_clear(&u->tree);
     if (reserve_index(u, st->mem, d, m, next->count, learn) ||
         vpdsi_kd_reserve(&u->tree, st->mem, m + 1, m + 1)) {
@@ -83,6 +89,8 @@ vpds_status vpdsi_uncovered_index(vpdsi_uncovered *u, vpdsi_store *st, const vpd
     }
     u->n_nwit = 0;
     u->learn = learn;
+    /* 64 bits hold the sub-boxes of sub_depth halvings when dim * sub_depth <= 6 */
+    u->sub_depth = learn > 1 && d <= 6 ? 6 / d : 0;
     u->n_centre_of = learn ? next->count : 0;
     u->half = 0;
     v = vpdsi_uncovered_view(u);
@@ -100,6 +108,7 @@ vpds_status vpdsi_uncovered_index(vpdsi_uncovered *u, vpdsi_store *st, const vpd
             memcpy(u->cbox + m * 2 * (size_t)d, lo, (size_t)d * sizeof(double));
             memcpy(u->cbox + m * 2 * (size_t)d + d, hi, (size_t)d * sizeof(double));
             u->state[m] = u->wit[m * d1 + (size_t)d] >= 0 ? VPDSI_CELL_WITNESS : VPDSI_CELL_UNKNOWN;
+            if (u->sub_depth > 0) u->sub[m] = 0;
         }
         vpdsi_kd_insert(&u->tree, &v, (int32_t)m);
         m++;
@@ -149,6 +158,19 @@ static const double *live_witness(vpdsi_uncovered *u, const vpdsi_ctx *ctx, doub
     if (!witness_covered(ctx, t, w)) return w;
     u->state[m] = VPDSI_CELL_UNKNOWN;
     return NULL;
+}
+
+int vpdsi_uncovered_child_covered(const vpdsi_uncovered *u, size_t pos, int d, int split, unsigned child)
+{
+    unsigned n;
+    uint64_t bits;
+    int32_t m;
+    if (!vpdsi_uncovered_indexed(u, pos) || u->sub_depth == 0) return 0;
+    m = u->centre_of[pos];
+    if (!split) return u->sub[m] == ~UINT64_C(0);
+    n = 1u << ((unsigned)d * (unsigned)(u->sub_depth - 1)); /* a child's sub-boxes, consecutive */
+    bits = (n >= 64 ? ~UINT64_C(0) : (UINT64_C(1) << n) - 1) << (child * n);
+    return (u->sub[m] & bits) == bits;
 }
 
 int vpdsi_uncovered_indexed(const vpdsi_uncovered *u, size_t pos)
@@ -256,13 +278,18 @@ vpds_status vpdsi_uncovered_dart(vpdsi_uncovered *u, const vpdsi_ctx *ctx, doubl
         memset(&out, 0, sizeof out);
         out.budget = used < VPDSI_UNCOVERED_BUDGET ? (size_t)(VPDSI_UNCOVERED_BUDGET - used) : 0;
         out.witness = wbuf;
+        if (u->sub_depth > 0) {
+            out.sub = u->sub + m;
+            out.sub_depth = u->sub_depth;
+        }
         if ((e = vpdsi_uncovered_in_box(u, ctx, t, y, y, ry, box, &out, &found)) != VPDS_OK) return e;
         if (found) { /* a witness, or the budget spent: "uncovered", as the whole search says */
             if (out.found_point) keep_witness(u, ctx, m, wbuf);
             *accept = 1;
             return VPDS_OK;
         }
-        if (whole) { /* covered now, so at every later question of this scale */
+        if (whole || (u->sub_depth > 0 && u->sub[m] == ~UINT64_C(0))) {
+            /* covered now, so at every later question of this scale */
             u->state[m] = VPDSI_CELL_COVERED;
             u->r[m] = 0.0;
         }
