@@ -333,8 +333,10 @@ int vpdsi_kd_ratio_within(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, cons
     while (top > 0) {
         int32_t n = stack[--top];
         const vpdsi_kd_node *nd = &t->nodes[n];
-        /* every sample of the node has a ratio of at least its box distance over rmax */
-        if (!(sqrt(vpdsi_box_mindist2(t, y, BOX_LO(t, n), BOX_HI(t, n))) <= bound * nd->rmax)) continue;
+        /* every sample of the node has a ratio of at least its box distance over rmax; the
+         * margin covers the ulp by which a periodic box distance may exceed a sample's */
+        if (!(sqrt(vpdsi_box_mindist2(t, y, BOX_LO(t, n), BOX_HI(t, n))) <= bound * nd->rmax * (1 + 1e-9)))
+            continue;
         if (nd->left < 0) {
             int32_t i;
             for (i = nd->head; i >= 0; i = t->next[i])

@@ -67,14 +67,14 @@ int vpdsi_kd_box_covered(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const
                          size_t n, const double *lo, const double *hi, double r_lo, int rule,
                          double scale);
 
+/* Whether some sample has |y - x| / r(x) <= bound (vpdsi_kd_min_ratio's per-sample ratio with
+ * the rule prior and no slack), stopping at the first that shows it. */
+int vpdsi_kd_ratio_within(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *y,
+                          double bound);
 /* The weighted nearest sample for the continuous stream (Section 4.2): the smallest
  * (|y - x| + slack) / f(r(x), ry) over all samples, with its index in *arg (-1: no sample, the
  * result is +INFINITY). With slack = 0 and ry = r(y) this is g(y) * coverage; with slack the
  * half-diagonal of a box around y and ry a lower bound of r there, it bounds g over the box. */
-/* Whether vpdsi_kd_min_ratio(t, s, y, 0, ry, VPDS_RULE_PRIOR) <= bound, stopping at the first
- * sample that shows it (same bits: the two compute each sample's ratio alike). */
-int vpdsi_kd_ratio_within(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *y,
-                          double bound);
 double vpdsi_kd_min_ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *y,
                           double slack, double ry, int rule, int32_t *arg);
 

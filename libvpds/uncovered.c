@@ -41,7 +41,9 @@ typedef struct {
     int found_point;  /* *found came from such a point, not from the budget or the precision */
     int drop_kept;    /* the box examined last was dropped for good: inside one coverage disk
                          or outside the domain (not for missing this question's region) */
-    uint64_t *sub;    /* version 6: the cell's sub-boxes shown covered (vpdsi_search_out.sub) */
+    uint64_t *sub;    /* version 6: the cell's sub-boxes shown covered, as this search goes */
+    uint64_t sub_now; /* where sub points: written back only when the search ends without an
+                         error, so that a retried dart takes the same boxes as the first try */
     int sub_depth;
     vpdsi_kd_samples view, uview;
     bb_lists lv[UNCOVERED_DEPTH + 1];
@@ -60,7 +62,7 @@ static size_t slot(int depth, int samples)
 int vpdsi_uncovered_near(const vpdsi_uncovered *u, const double *p, double thr)
 {
     vpdsi_kd_samples v = vpdsi_uncovered_view(u);
-    if (!u->ready) return 1;
+    if (!u->ready || !(thr < INFINITY)) return 1; /* as the nearest centre compared with thr was */
     return vpdsi_kd_ratio_within(&u->tree, &v, p, thr);
 }
 
@@ -437,12 +439,14 @@ vpds_status vpdsi_uncovered_in_box(vpdsi_uncovered *u, const vpdsi_ctx *ctx, dou
         q.witness = out->witness;
         q.in_cell = q.in_cell || out->in_indexed;
         if (cell && out->sub && out->sub_depth > 0) {
-            q.sub = out->sub;
+            q.sub_now = *out->sub;
+            q.sub = &q.sub_now;
             q.sub_depth = out->sub_depth;
         }
     }
     q.slack = list_slack(ctx->pb, u->stack, u->stack + d);
     e = search(&q, found);
+    if (e == VPDS_OK && q.sub) *out->sub = q.sub_now;
     if (out) out->found_point = q.found_point;
     return e;
 }

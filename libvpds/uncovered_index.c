@@ -59,7 +59,14 @@ static int reserve_index(vpdsi_uncovered *u, vpdsi_mem *mem, int d, size_t m, si
            vpdsi_mem_reserve(mem, (void **)&u->state, &u->cap_state, m + 1, 1) ||
            vpdsi_mem_reserve(mem, (void **)&u->centre_of, &u->cap_centre_of, n + 1, sizeof(int32_t)) ||
            vpdsi_mem_reserve(mem, (void **)&u->nwit, &u->cap_nwit, nw, sizeof(double)) ||
-           (learn > 1 && vpdsi_mem_reserve(mem, (void **)&u->sub, &u->cap_sub, m + 1, sizeof(uint64_t)));
+           (learn > 1 && d <= 6 && vpdsi_mem_reserve(mem, (void **)&u->sub, &u->cap_sub, m + 1, sizeof(uint64_t)));
+}
+
+/* Every sub-box of a cell: the 2^(dim * sub_depth) low bits. */
+static uint64_t all_sub(const vpdsi_uncovered *u, int d)
+{
+    unsigned n = 1u << ((unsigned)d * (unsigned)u->sub_depth);
+    return n >= 64 ? ~UINT64_C(0) : (UINT64_C(1) << n) - 1;
 }
 
 vpds_status vpdsi_uncovered_index(vpdsi_uncovered *u, vpdsi_store *st, const vpdsi_cells *next,
@@ -167,7 +174,7 @@ int vpdsi_uncovered_child_covered(const vpdsi_uncovered *u, size_t pos, int d, i
     int32_t m;
     if (!vpdsi_uncovered_indexed(u, pos) || u->sub_depth == 0) return 0;
     m = u->centre_of[pos];
-    if (!split) return u->sub[m] == ~UINT64_C(0);
+    if (!split) return u->sub[m] == all_sub(u, d);
     n = 1u << ((unsigned)d * (unsigned)(u->sub_depth - 1)); /* a child's sub-boxes, consecutive */
     bits = (n >= 64 ? ~UINT64_C(0) : (UINT64_C(1) << n) - 1) << (child * n);
     return (u->sub[m] & bits) == bits;
@@ -288,7 +295,7 @@ vpds_status vpdsi_uncovered_dart(vpdsi_uncovered *u, const vpdsi_ctx *ctx, doubl
             *accept = 1;
             return VPDS_OK;
         }
-        if (whole || (u->sub_depth > 0 && u->sub[m] == ~UINT64_C(0))) {
+        if (whole || (u->sub_depth > 0 && u->sub[m] == all_sub(u, d))) {
             /* covered now, so at every later question of this scale */
             u->state[m] = VPDSI_CELL_COVERED;
             u->r[m] = 0.0;
