@@ -3,10 +3,13 @@
 `--quick`: smaller workloads; `--stream`: only the continuous-stream rows.
 
 Peers come from the registries and are installed here, into build/bench: scipy's
-qmc.PoissonDisk (PyPI), the npm package poisson-disk-sampling, the Rust crate fast_poisson.
-None of them is maximal; all are Bridson-style (biased) samplers. The floor is drawing the same
-number of uniform random points with libvpds's own generator. Times are wall-clock seconds of
-one run on this machine, one core.
+qmc.PoissonDisk (PyPI), the npm package poisson-disk-sampling, the Rust crate fast_poisson (all
+three Bridson-style, biased samplers) and the Rust crate poisson 0.10.1 in its "Ebeida" mode (after
+Ebeida et al. 2012, the maximal sampler's design). Each peer's output is measured for what it is
+beside its time: its smallest distance between two points against the minimum distance asked,
+and the share of random probes with room for another point (farther than that distance from
+every point: 0 for a maximal set). The floor is drawing the same number of uniform random points
+with libvpds's own generator. Times are wall-clock seconds of one run on this machine, one core.
 """
 from __future__ import annotations
 
@@ -48,14 +51,54 @@ def install_peers() -> dict[str, object]:
         env = dict(os.environ, CARGO_TARGET_DIR=str(OUT / "rust"))
         sh([cargo, "build", "--release", "-q"], cwd=ROOT / "bench" / "peers" / "rust", env=env)
         peers["rust"] = OUT / "rust" / "release" / "vpds-bench-fast-poisson"
+        peers["ebeida"] = OUT / "rust" / "release" / "ebeida"
     except Exception as e:  # noqa: BLE001
-        print("fast_poisson unavailable:", e)
+        print("fast_poisson and poisson (crates) unavailable:", e)
     return peers
 
 
 def vpds(*args) -> tuple[int, float, int]:
     out = sh([str(OUT / "bench"), *map(str, args)]).split()
     return int(out[1]), float(out[2]), int(out[3])
+
+
+PROBES = 200_000
+
+
+def output_quality(points, r: float, dim: int) -> str:
+    """What a sampler's output is: its smallest pairwise distance over r (>= 1: no conflict) and
+    the share of PROBES uniform probes of the unit box farther than r from every point, where
+    another point would fit (0 for a maximal set; a probe's resolution is 1/PROBES)."""
+    import numpy as np
+    from scipy.spatial import cKDTree
+    pts = np.asarray(points, dtype=float).reshape(-1, dim)
+    tree = cKDTree(pts)
+    nearest, _ = tree.query(pts, k=2)
+    probes = np.random.default_rng(12345).random((PROBES, dim))
+    gap, _ = tree.query(probes, k=1)
+    free = gap >= r
+    room = float(np.mean(free))
+    upper = float(np.mean(np.any(probes[free] > 1 - r, axis=1))) if free.any() else 0.0
+    return (f"   output: {len(pts):,d} points, smallest distance {nearest[:, 1].min() / r:.4f} r, "
+            f"room for another point at {100 * room:.3f}% of {PROBES:,d} probes"
+            + (" (maximal: none)" if room == 0 else
+               f" ({100 * upper:.0f}% of those within r of an upper face)"))
+
+
+def peer_points(cmd: list[str], dim: int) -> tuple[int, float, object]:
+    """Runs a peer that writes its points to the file named last: (n, seconds, points)."""
+    import numpy as np
+    path = OUT / "peer_points.txt"
+    out = sh([*cmd, str(path)]).split()
+    pts = np.loadtxt(path, ndmin=2).reshape(-1, dim)
+    path.unlink()
+    return int(out[0]), float(out[1]), pts
+
+
+def vpds_points(dim: int, r: float):
+    """libvpds's own output at the bench's seed, through the Python binding (the same C run)."""
+    import vpds as lib
+    return lib.PoissonDisk(dim, radius=r, seed=1, progress=False).fill_space()
 
 
 def radius_for(n: float, dim: int) -> float:
@@ -82,16 +125,22 @@ def main() -> None:
     base_rate = n / sec
     fn, fsec, _ = vpds("floor", n, 2)
     row("floor: same count of uniform points", fn, fsec, note=f"libvpds is {sec / fsec:.0f}x the floor")
+    print(output_quality(vpds_points(2, r), r, 2), flush=True)
     if "npm" in peers:
-        out = sh(["node", str(peers["npm"]), repr(r), "1"]).split()
-        pn, ps = int(out[0]), float(out[1])
+        pn, ps, pts = peer_points(["node", str(peers["npm"]), repr(r), "1"], 2)
         row("npm poisson-disk-sampling (not maximal)", pn, ps,
             note=f"libvpds/peer samples-per-second: {base_rate / (pn / ps):.2f}")
+        print(output_quality(pts, r, 2), flush=True)
     if "rust" in peers:
-        out = sh([str(peers["rust"]), "2", repr(r), "1"]).split()
-        pn, ps = int(out[0]), float(out[1])
+        pn, ps, pts = peer_points([str(peers["rust"]), "2", repr(r), "1"], 2)
         row("crate fast_poisson (not maximal)", pn, ps,
             note=f"libvpds/peer samples-per-second: {base_rate / (pn / ps):.2f}")
+        print(output_quality(pts, r, 2), flush=True)
+    if "ebeida" in peers:  # its radius is half the minimum distance: the binary passes r / 2
+        pn, ps, pts = peer_points([str(peers["ebeida"]), "2", repr(r), "1"], 2)
+        row("crate poisson 0.10.1, Ebeida mode", pn, ps,
+            note=f"libvpds/peer samples-per-second: {base_rate / (pn / ps):.2f}")
+        print(output_quality(pts, r, 2), flush=True)
     if "scipy" in peers:
         # scipy is too slow for a million: compare on a smaller workload, both sides
         rs = radius_for(2e4, 2)
@@ -103,6 +152,7 @@ def main() -> None:
         row(f"libvpds 2D uniform r={rs:.5f}", vn, vs)
         row("scipy qmc.PoissonDisk.fill_space (not maximal)", len(pts), ss,
             note=f"libvpds/peer samples-per-second: {(vn / vs) / (len(pts) / ss):.1f}")
+        print(output_quality(pts, rs, 2), flush=True)
 
     # variable radii: the paper's ramp, each rule, beside the uniform time per sample
     for rule in ("prior", "current", "bigger", "smaller"):
@@ -128,6 +178,15 @@ def main() -> None:
         row("libvpds 3D uniform (1e5)", vn, vs)
         row("crate fast_poisson 3D (1e5)", int(out[0]), float(out[1]),
             note=f"libvpds/peer samples-per-second: {(vn / vs) / (int(out[0]) / float(out[1])):.2f}")
+    if "ebeida" in peers:  # about 1,000 samples/s in 3D: 1e4 samples (3e3 with --quick)
+        r3 = radius_for(3e3 if QUICK else 1e4, 3)
+        vn, vs, _ = vpds("uniform", 3, r3)
+        row(f"libvpds 3D uniform r={r3:.4f}", vn, vs)
+        print(output_quality(vpds_points(3, r3), r3, 3), flush=True)
+        pn, ps, pts = peer_points([str(peers["ebeida"]), "3", repr(r3), "1"], 3)
+        row("crate poisson 0.10.1 3D, Ebeida mode", pn, ps,
+            note=f"libvpds/peer samples-per-second: {(vn / vs) / (pn / ps):.2f}")
+        print(output_quality(pts, r3, 3), flush=True)
     # 4D (the high-dimension issue's yardstick: r = 0.06, about 7.5e4 samples; 0.1 with --quick)
     r4 = 0.1 if QUICK else 0.06
     n, sec, mem = vpds("uniform", 4, r4)
