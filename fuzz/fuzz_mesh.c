@@ -1,6 +1,7 @@
 /* Mesh descriptors and runs from the input: up to 10 vertices (NaN, inf and huge values now and
  * then), up to 8 triangles with any indices (out of range, repeated: degenerate), a radius or
- * vertex radii, a rule, a budget; a run or the stream. A refused descriptor has a documented status and a message,
+ * vertex radii, a rule, a budget; a run or the stream, and mixed: a stream after the run, a refine
+ * after the stream. A refused descriptor has a documented status and a message,
  * and create refuses it too; an accepted one runs (through pauses) to a documented status, its
  * samples on their triangles and conflict-free, and a completed run covers probes on every
  * triangle of area. */
@@ -115,7 +116,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
         check_status(st);
         FUZZ_ASSERT(st == VPDS_OK, "stream status %d: %s", (int)st, vpds_mesh_last_error(s));
-        FUZZ_ASSERT(vpds_mesh_run(s) == VPDS_ERR_STATE, "a run after the stream");
+        /* the samples are maximal at the last t: a run has nothing to add */
+        i = vpds_mesh_count(s);
+        FUZZ_ASSERT(vpds_mesh_run(s) == VPDS_OK && vpds_mesh_count(s) == i, "a run after the stream");
+        if ((mode & 4) && isfinite(last)) { /* a refine below it, through its pauses */
+            for (calls = 0; calls < 2000 && (st = vpds_mesh_refine(s, 0.8 * last)) == VPDS_PAUSED; calls++) {}
+            check_status(st);
+            FUZZ_ASSERT(st == VPDS_OK || st == VPDS_PAUSED || st == VPDS_ERR_OVERFLOW, "refine after the stream: "
+                        "status %d: %s", (int)st, vpds_mesh_last_error(s));
+        }
         check_run(s, v, tri, nt, d.vertex_radii, d.radius, d.rule, 0, VPDS_STREAM_TOLERANCE);
         vpds_mesh_destroy(s);
         return 0;
@@ -127,6 +136,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     check_run(s, v, tri, nt, d.vertex_radii, d.radius, d.rule,
               st == VPDS_OK && vpds_mesh_get_stats(s).delta == 0, 0);
     if (st == VPDS_OK) FUZZ_ASSERT(vpds_mesh_get_stats(s).maximal, "completed but not maximal");
+    if (st == VPDS_OK && (mode & 4)) { /* the stream continued after the run: t <= 1, never rising */
+        double x[3], t, last = 1.0;
+        for (calls = 0; calls < 20 && (st = vpds_mesh_next(s, 0, x, &t)) == VPDS_OK; calls++) {
+            FUZZ_ASSERT(t <= last && !isnan(t), "stream after a run: t %g after %g", t, last);
+            last = t;
+        }
+        check_status(st);
+        FUZZ_ASSERT(st == VPDS_OK, "stream after a run: status %d: %s", (int)st, vpds_mesh_last_error(s));
+        check_run(s, v, tri, nt, d.vertex_radii, d.radius, d.rule, 0, VPDS_STREAM_TOLERANCE);
+    }
     vpds_mesh_destroy(s);
     return 0;
 }

@@ -553,9 +553,11 @@ VPDS_API vpds_status vpds_mesh_refine(vpds_mesh *mesh, double t);
  * from the samples in the rule's scaled distance, found by branch and bound, with its scale t
  * (+INFINITY for the first sample, uniform by area). Each prefix {x_k : t_k >= t} covers the
  * surface at t * coverage and keeps conflict-free at t * inhibition * (1 - VPDS_STREAM_TOLERANCE).
- * VPDS_STREAM_END: the next sample's t would be at or below t_min (nothing consumed). This
- * version streams from an empty mesh sampler only, and a streaming one refuses runs
- * (VPDS_ERR_STATE). x_out: 3 doubles; face and barycentrics through vpds_mesh_faces/_barycentrics. */
+ * VPDS_STREAM_END: the next sample's t would be at or below t_min (nothing consumed). From an
+ * empty mesh sampler or a completed run (its t caps the scales; a paused run: VPDS_ERR_STATE);
+ * each event leaves the samples maximal at its t, so vpds_mesh_run then has nothing to add and
+ * vpds_mesh_refine goes below it. x_out: 3 doubles; face and barycentrics through
+ * vpds_mesh_faces/_barycentrics. */
 VPDS_API vpds_status vpds_mesh_next(vpds_mesh *mesh, double t_min, double *x_out, double *t_out);
 VPDS_API vpds_status vpds_mesh_set_budget(vpds_mesh *mesh, uint64_t budget);
 VPDS_API size_t vpds_mesh_count(const vpds_mesh *mesh);

@@ -360,33 +360,25 @@ static vpdsi_surface_ctx mesh_context(vpds_mesh *s)
 static vpds_status mesh_work(vpds_mesh *s)
 {
     vpdsi_surface_ctx c = mesh_context(s);
+    size_t before = s->store.n;
+    vpds_status e;
     s->store.err[0] = 0;
-    return vpdsi_surface_run(&s->surface, &c);
-}
-
-/* Runs and the stream do not mix in this version: say so, change nothing. */
-static vpds_status refuse_after_stream(vpds_mesh *s, const char *call)
-{
-    if (!s->stream.started) return VPDS_OK;
-    vpdsi_store_error(&s->store, "%s after vpds_mesh_next: a mesh sampler either runs (vpds_mesh_run, "
-                      "vpds_mesh_refine) or streams, not both", call);
-    return VPDS_ERR_STATE;
+    e = vpdsi_surface_run(&s->surface, &c);
+    /* a run after a stream: the stream's best point seen is stale once samples are added */
+    if (s->store.n != before) s->stream.best.g = -1;
+    return e;
 }
 
 vpds_status vpds_mesh_run(vpds_mesh *s)
 {
-    vpds_status e;
     if (!live(s)) return VPDS_ERR_INVALID_ARGUMENT;
-    if ((e = refuse_after_stream(s, "vpds_mesh_run")) != VPDS_OK) return e;
     if (s->surface.phase == VPDSI_SURF_IDLE) vpdsi_surface_begin(&s->surface, 1.0);
     return mesh_work(s);
 }
 
 vpds_status vpds_mesh_refine(vpds_mesh *s, double t)
 {
-    vpds_status e;
     if (!live(s)) return VPDS_ERR_INVALID_ARGUMENT;
-    if ((e = refuse_after_stream(s, "vpds_mesh_refine")) != VPDS_OK) return e;
     if (s->surface.phase != VPDSI_SURF_IDLE && t == s->surface.t) return mesh_work(s);
     if (!isfinite(t) || !vpdsi_scale_ok(t * s->coverage)) {
         vpdsi_store_error(&s->store, "t = %g: must be finite, > 0, with t * coverage within [1e-50, 1e50]", t);
@@ -408,6 +400,7 @@ vpds_status vpds_mesh_refine(vpds_mesh *s, double t)
 vpds_status vpds_mesh_next(vpds_mesh *s, double t_min, double *x_out, double *t_out)
 {
     vpdsi_surface_ctx c;
+    vpds_status e;
     if (!live(s)) return VPDS_ERR_INVALID_ARGUMENT;
     if (!x_out || !t_out) {
         vpdsi_store_error(&s->store, "vpds_mesh_next: x_out and t_out must not be NULL");
@@ -417,14 +410,19 @@ vpds_status vpds_mesh_next(vpds_mesh *s, double t_min, double *x_out, double *t_
         vpdsi_store_error(&s->store, "vpds_mesh_next: t_min = %g: must be finite and >= 0", t_min);
         return VPDS_ERR_INVALID_ARGUMENT;
     }
-    if (s->surface.phase != VPDSI_SURF_IDLE) {
-        vpdsi_store_error(&s->store, "vpds_mesh_next after vpds_mesh_run or vpds_mesh_refine: the stream "
-                          "starts from an empty mesh sampler in this version");
+    if (s->surface.phase != VPDSI_SURF_IDLE && s->surface.phase != VPDSI_SURF_DONE) {
+        vpdsi_store_error(&s->store, "vpds_mesh_next: the run at scale %g is not finished; a stream "
+                          "starts from an empty mesh sampler or a maximal one (call vpds_mesh_run "
+                          "until VPDS_OK)", s->surface.t);
         return VPDS_ERR_STATE;
     }
     c = mesh_context(s);
     s->store.err[0] = 0;
-    return vpdsi_surface_next(&s->stream, &c, t_min, x_out, t_out);
+    e = vpdsi_surface_next(&s->stream, &c, t_min,
+                           s->surface.phase == VPDSI_SURF_DONE ? s->surface.t : INFINITY, x_out, t_out);
+    /* the samples are maximal at t (Section 4.2): a later refine goes below it */
+    if (e == VPDS_OK) vpdsi_surface_done_at(&s->surface, &s->mem, *t_out);
+    return e;
 }
 
 vpds_status vpds_mesh_set_budget(vpds_mesh *s, uint64_t budget)
@@ -452,7 +450,7 @@ vpds_stats vpds_mesh_get_stats(const vpds_mesh *s)
     st.bytes_held = s->mem.held;
     st.peak_bytes = s->mem.peak;
     st.sizing_calls = s->store.sizing.calls;
-    st.t = s->stream.started ? (s->store.n ? s->store.t[s->store.n - 1] : INFINITY) : s->surface.t;
+    st.t = s->surface.t; /* a stream's event leaves the surface maximal at its t */
     st.maximal = s->surface.phase == VPDSI_SURF_DONE;
     return st;
 }

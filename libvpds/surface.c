@@ -46,6 +46,13 @@ void vpdsi_surface_release(vpdsi_surface *s, vpdsi_mem *m)
     release_pieces(s, m);
 }
 
+void vpdsi_surface_done_at(vpdsi_surface *s, vpdsi_mem *m, double t)
+{
+    release_pieces(s, m);
+    s->t = t;
+    s->phase = VPDSI_SURF_DONE;
+}
+
 void vpdsi_surface_begin(vpdsi_surface *s, double t)
 {
     s->prev_t = s->t;

@@ -43,6 +43,9 @@ typedef struct vpdsi_surface {
 
 void vpdsi_surface_init(vpdsi_surface *s);
 void vpdsi_surface_release(vpdsi_surface *s, vpdsi_mem *m);
+/* The samples are maximal at t (a stream's event): a later run at t is done, a refine goes
+ * below it; the pieces are released. */
+void vpdsi_surface_done_at(vpdsi_surface *s, vpdsi_mem *m, double t);
 /* Start sampling at scale t (the store may hold samples of larger scales). */
 void vpdsi_surface_begin(vpdsi_surface *s, double t);
 /* Work until maximal at s->t (VPDS_OK), paused (VPDS_PAUSED) or failed (the state as a pause). */

@@ -72,8 +72,32 @@ static vpds_status piece_upper_bound(const vpdsi_surface_ctx *ctx, const vpdsi_p
     return VPDS_OK;
 }
 
-/* The first sample, uniform by area over the surface (t = infinity), and every live triangle as
- * a piece of the heap with an unknown (infinite) bound. */
+/* Room for the heap of every live triangle as one piece. */
+static vpds_status reserve_heap(vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ctx)
+{
+    if (vpdsi_mem_reserve(ctx->st->mem, (void **)&ss->heap, &ss->cap_heap, ctx->mesh->n_live, sizeof *ss->heap)) {
+        vpdsi_store_error(ctx->st, "out of memory for the stream's %zu pieces", ctx->mesh->n_live);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    return VPDS_OK;
+}
+
+/* Every live triangle as a piece of the heap with an unknown (infinite) bound: the stream's
+ * search starts over the whole surface. */
+static void start_heap(vpdsi_surface_stream *ss, const vpdsi_trimesh *mesh)
+{
+    size_t k;
+    for (k = 0; k < mesh->n_live; k++) {
+        memset(&ss->heap[k], 0, sizeof ss->heap[k]);
+        ss->heap[k].p.tri = (uint32_t)k;
+        ss->heap[k].ub = INFINITY;
+    }
+    ss->n_heap = mesh->n_live;
+    ss->started = 1;
+    ss->best.g = -1;
+}
+
+/* The first sample, uniform by area over the surface (t = infinity), and the heap started. */
 static vpds_status first_surface_sample(vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ctx,
                                 double *x_out, double *t_out)
 {
@@ -82,10 +106,7 @@ static vpds_status first_surface_sample(vpdsi_surface_stream *ss, const vpdsi_su
     double total = 0, u, a, b, uv[2], x[3], r;
     size_t k, pick = 0;
     vpds_status e;
-    if (vpdsi_mem_reserve(ctx->st->mem, (void **)&ss->heap, &ss->cap_heap, mesh->n_live, sizeof *ss->heap)) {
-        vpdsi_store_error(ctx->st, "out of memory for the stream's %zu pieces", mesh->n_live);
-        return VPDS_ERR_OUT_OF_MEMORY;
-    }
+    if ((e = reserve_heap(ss, ctx)) != VPDS_OK) return e;
     if ((e = vpdsi_marks_reserve(ctx->marks, ctx->st, 1)) != VPDS_OK) return e;
     for (k = 0; k < mesh->n_live; k++) total += mesh->area[k];
     u = vpdsi_rng_unit(ctx->rng) * total;
@@ -107,16 +128,9 @@ static vpds_status first_surface_sample(vpdsi_surface_stream *ss, const vpdsi_su
         *ctx->rng = before;
         return e;
     }
-    for (k = 0; k < mesh->n_live; k++) {
-        memset(&ss->heap[k], 0, sizeof ss->heap[k]);
-        ss->heap[k].p.tri = (uint32_t)k;
-        ss->heap[k].ub = INFINITY;
-    }
-    ss->n_heap = mesh->n_live;
+    start_heap(ss, mesh);
     vpdsi_marks_append(ctx->marks, ctx->st, mesh, (uint32_t)pick, uv, x, r, INFINITY);
     ctx->stats->accepted++;
-    ss->started = 1;
-    ss->best.g = -1;
     memcpy(x_out, x, 3 * sizeof *x);
     *t_out = INFINITY;
     return VPDS_OK;
@@ -192,12 +206,21 @@ static int may_split(const vpdsi_surface_ctx *ctx, const vpdsi_piece *p)
 }
 
 vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ctx,
-                               double t_min, double *x_out, double *t_out)
+                               double t_min, double t_max, double *x_out, double *t_out)
 {
     vpdsi_surface_best *best = &ss->best;
-    if (!ss->started) return first_surface_sample(ss, ctx, x_out, t_out);
+    vpds_status e0;
+    /* a run may have filed its samples in another index: the bounds read the kd-tree */
+    if ((e0 = vpdsi_store_sync_tree(ctx->st)) != VPDS_OK) return e0;
+    if (!ss->started) {
+        vpds_status e;
+        if (ctx->st->n == 0) return first_surface_sample(ss, ctx, x_out, t_out);
+        /* after a run: the search starts from its samples */
+        if ((e = reserve_heap(ss, ctx)) != VPDS_OK) return e;
+        start_heap(ss, ctx->mesh);
+    }
     for (;;) {
-        double ub;
+        double ub, t;
         vpds_status e = piece_upper_bound(ctx, &ss->heap[0].p, &ub);
         if (e != VPDS_OK) return e;
         if (ub < ss->heap[0].ub) {
@@ -206,16 +229,17 @@ vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx
             heap_sift_down(ss->heap, ss->n_heap, 0);
             continue;
         }
-        if (!(ub / ctx->coverage > t_min)) return VPDS_STREAM_END;
+        /* after a run at t_max, maximal there up to its precision: no event above it */
+        t = ub / ctx->coverage < t_max ? ub / ctx->coverage : t_max;
+        if (!(t > t_min)) return VPDS_STREAM_END;
         /* ub bounds g over the whole surface: a point within the tolerance of it is the next */
         if ((e = look_at_centre(ctx, &ss->heap[0].p, best)) != VPDS_OK) return e;
         if (best->g >= ub * (1 - VPDS_STREAM_TOLERANCE) || !may_split(ctx, &ss->heap[0].p)) {
             if ((e = vpdsi_marks_reserve(ctx->marks, ctx->st, 1)) != VPDS_OK) return e;
-            vpdsi_marks_append(ctx->marks, ctx->st, ctx->mesh, best->tri, best->uv, best->x, best->r,
-                               ub / ctx->coverage);
+            vpdsi_marks_append(ctx->marks, ctx->st, ctx->mesh, best->tri, best->uv, best->x, best->r, t);
             ctx->stats->accepted++;
             memcpy(x_out, best->x, sizeof best->x);
-            *t_out = ub / ctx->coverage;
+            *t_out = t;
             best->g = -1; /* new sample: every g seen is stale */
             return VPDS_OK;
         }

@@ -29,7 +29,9 @@ typedef struct vpdsi_surface_stream {
 
 void vpdsi_surface_stream_release(vpdsi_surface_stream *ss, vpdsi_mem *m);
 /* The next sample into x_out (3 doubles), its scale into *t_out: VPDS_OK, or VPDS_STREAM_END when
- * its scale would be at or below t_min (nothing consumed), or an error (nothing consumed). */
+ * its scale would be at or below t_min (nothing consumed), or an error (nothing consumed). The
+ * store may hold the samples of a run maximal at t_max (+INFINITY: none), which caps the scales;
+ * samples added between two calls (a refine) are taken as they are. */
 vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ctx,
-                               double t_min, double *x_out, double *t_out);
+                               double t_min, double t_max, double *x_out, double *t_out);
 #endif

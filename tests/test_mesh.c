@@ -851,7 +851,7 @@ static size_t uncovered_probes(const mesh_t *m, const double *vr, radius_fn rf, 
 
 /* The stream on a surface: n samples, t non-increasing, each prefix covered at its t and
  * conflict-free within the stream's tolerance, by brute force; determinism, STREAM_END consuming
- * nothing, runs and streams refusing to mix, every allocation failing once. */
+ * nothing, a paused run refusing to stream, every allocation failing once. */
 static void stream_case(const char *what, const mesh_t *m, const double *vr, radius_fn rf, vpds_rule rule,
                         double radius, size_t n)
 {
@@ -898,6 +898,72 @@ static void stream_case(const char *what, const mesh_t *m, const double *vr, rad
     vpds_mesh_destroy(s);
 }
 
+/* Conflicts of the stream's promise among all samples: sample j against each earlier i, within
+ * ts[j] * f * (1 - VPDS_STREAM_TOLERANCE); brute force. */
+static size_t stream_conflicts(const vpds_mesh *s, vpds_rule rule)
+{
+    const double *xs = vpds_mesh_points(s), *rs = vpds_mesh_radii(s), *ts = vpds_mesh_scales(s);
+    size_t i, j, n = vpds_mesh_count(s), bad = 0;
+    for (j = 1; j < n; j++)
+        for (i = 0; i < j; i++) {
+            double d2 = 0, fr = ts[j] * rule_f(rule, rs[i], rs[j]) * (1 - VPDS_STREAM_TOLERANCE);
+            int q;
+            for (q = 0; q < 3; q++) d2 += (xs[3 * i + q] - xs[3 * j + q]) * (xs[3 * i + q] - xs[3 * j + q]);
+            bad += d2 < fr * fr;
+        }
+    return bad;
+}
+
+/* Runs and streams mix as on a box: a stream continued after a run (its scales at most the
+ * run's, each prefix covered at its t), a refine after a stream (maximal at its t), a stream
+ * again after that; the same seed gives the same samples. */
+static void test_stream_mixing(void)
+{
+    mesh_t sphere = icosphere(3);
+    vpds_mesh_desc d = desc_for(&sphere);
+    vpds_mesh *a = NULL, *b = NULL;
+    double x[3], t, last = 1.0, t_ref;
+    size_t k, n_run, bad_t = 0;
+    vpds_rule rule = VPDS_RULE_SMALLER;
+    d.radius = r_const_val = 0.3;
+    d.seed = 11;
+    /* a run at t = 1, then the stream: t <= 1, non-increasing, each prefix covered at its t */
+    if (vpds_mesh_create(&d, &a) != VPDS_OK || vpds_mesh_run(a) != VPDS_OK) { CHECK(0); return; }
+    n_run = vpds_mesh_count(a);
+    for (k = 0; k < 30; k++) {
+        CHECK(vpds_mesh_next(a, 0, x, &t) == VPDS_OK);
+        bad_t += !(t <= last);
+        last = t;
+        if (k % 10 == 9)
+            CHECK_MSG(uncovered_probes(&sphere, NULL, r_const, rule, t, vpds_mesh_points(a), vpds_mesh_radii(a),
+                                       vpds_mesh_count(a) - 1, quick ? 6 : 10) == 0,
+                      "stream after a run: the prefix before event %zu does not cover at its t %g", k, t);
+    }
+    CHECK_MSG(bad_t == 0 && vpds_mesh_count(a) == n_run + 30, "stream after a run: %zu scales out of order", bad_t);
+    CHECK_MSG(stream_conflicts(a, rule) == 0, "stream after a run: pairs in conflict");
+    /* a refine below the last event: maximal there, every pair kept apart */
+    t_ref = 0.7 * last;
+    CHECK(vpds_mesh_refine(a, t_ref) == VPDS_OK && vpds_mesh_count(a) > n_run + 30);
+    {
+        report_t rep = check_mesh_run(a, &sphere, NULL, r_const, rule, t_ref, 0.3, 0.3);
+        CHECK_MSG(rep.uncovered == 0 && rep.off_surface == 0, "refine after a stream: %zu of %zu probes uncovered",
+                  rep.uncovered, rep.probes);
+        CHECK(stream_conflicts(a, rule) == 0);
+    }
+    /* the stream again, below the refine's scale */
+    CHECK(vpds_mesh_next(a, 0, x, &t) == VPDS_OK && t <= t_ref);
+    CHECK(stream_conflicts(a, rule) == 0);
+    /* the same calls, the same samples */
+    if (vpds_mesh_create(&d, &b) == VPDS_OK && vpds_mesh_run(b) == VPDS_OK) {
+        for (k = 0; k < 30; k++) CHECK(vpds_mesh_next(b, 0, x, &t) == VPDS_OK);
+        CHECK(vpds_mesh_refine(b, t_ref) == VPDS_OK && vpds_mesh_next(b, 0, x, &t) == VPDS_OK);
+        CHECK(same_samples(a, b));
+    }
+    vpds_mesh_destroy(a);
+    vpds_mesh_destroy(b);
+    mesh_free(&sphere);
+}
+
 static void test_stream(void)
 {
     mesh_t sphere = icosphere(3), sq = {0};
@@ -924,13 +990,18 @@ static void test_stream(void)
     CHECK(vpds_mesh_next(a, 0, xa, &ta) == VPDS_OK && ta <= t);
     for (i = 0; i < 41; i++) CHECK(vpds_mesh_next(b, 0, x, &t) == VPDS_OK);
     CHECK(memcmp(x, xa, sizeof x) == 0 && t == ta && same_samples(a, b));
-    CHECK(vpds_mesh_run(a) == VPDS_ERR_STATE && strstr(vpds_mesh_last_error(a), "not both"));
-    CHECK(vpds_mesh_refine(a, 0.5) == VPDS_ERR_STATE && vpds_mesh_count(a) == 41);
+    /* a stream leaves the samples maximal at its last t: a run there has nothing to do, a
+     * refine above it is refused, nothing changed */
+    CHECK(vpds_mesh_get_stats(a).maximal && vpds_mesh_get_stats(a).t == ta);
+    CHECK(vpds_mesh_run(a) == VPDS_OK && vpds_mesh_count(a) == 41);
+    CHECK(vpds_mesh_refine(a, 2 * ta) == VPDS_ERR_INVALID_ARGUMENT && vpds_mesh_count(a) == 41);
     CHECK(vpds_mesh_next(a, -1, x, &t) == VPDS_ERR_INVALID_ARGUMENT);
     CHECK(vpds_mesh_next(a, 0, NULL, &t) == VPDS_ERR_INVALID_ARGUMENT);
     vpds_mesh_destroy(a);
-    CHECK(vpds_mesh_create(&d, &a) == VPDS_OK && vpds_mesh_run(a) == VPDS_OK);
-    CHECK(vpds_mesh_next(a, 0, x, &t) == VPDS_ERR_STATE && strstr(vpds_mesh_last_error(a), "empty mesh sampler"));
+    /* a paused run does not stream */
+    CHECK(vpds_mesh_create(&d, &a) == VPDS_OK && vpds_mesh_set_budget(a, 5) == VPDS_OK &&
+          vpds_mesh_run(a) == VPDS_PAUSED);
+    CHECK(vpds_mesh_next(a, 0, x, &t) == VPDS_ERR_STATE && strstr(vpds_mesh_last_error(a), "not finished"));
     vpds_mesh_destroy(a);
     /* every allocation failing once: the retried stream gives the same points */
     d.allocator.alloc = ca_alloc;
@@ -1117,6 +1188,7 @@ int main(void)
     test_determinism();
     test_bias();
     test_stream();
+    test_stream_mixing();
     test_wide_extent();
     test_lone_sliver();
     test_refine_refused();

@@ -141,8 +141,21 @@ def test_exactly_n_points_from_the_stream():
     again = vpds.MeshSampler(m, radius=0.2, rng=3)
     again.progressive(60)
     np.testing.assert_array_equal(again.progressive(150).points, s.points)
-    with pytest.raises(vpds.VpdsStateError, match="not both"):
-        again.run()
+    # runs and the stream mix: a run after it has nothing to add (maximal at its last scale), a
+    # refine goes below that scale, and a stream continues a run at scales up to the run's
+    assert len(again.run().samples.points) == 150
+    t_last = float(s.scales[-1])
+    refined = again.refine(0.8 * t_last).samples
+    assert len(refined.points) > 150 and refined.maximal
+    d, _ = cKDTree(refined.points).query(y)
+    assert d.max() <= 0.8 * t_last * 0.2 * (1 + 1e-9)
+    ran = vpds.MeshSampler(m, radius=0.2, rng=3).run()
+    n_run = len(ran.samples.points)
+    more = ran.progressive(n_run + 20)
+    assert len(more.points) == n_run + 20
+    assert np.all(more.scales[n_run:] <= 1) and np.all(np.diff(more.scales[n_run:]) <= 0)
+    dd, _ = cKDTree(more.points).query(more.points, k=2)
+    assert dd[:, 1].min() >= more.scales[-1] * 0.2 * (1 - vpds.STREAM_TOLERANCE)
     with pytest.raises(ValueError, match="give one"):
         vpds.sample_mesh(m, n=10, t=0.5)
 

@@ -141,7 +141,8 @@ class MeshSampler:
         """Continue the stream to n samples in all (the first ones stay): each prefix is
         conflict-free and maximal at its own scale, so the n points are evenly spread at the
         last one's t (the farthest point of the surface in the rule's scaled distance, each in
-        turn; the first uniform by area). A sampler that ran does not stream."""
+        turn; the first uniform by area). After a run the stream continues from its samples,
+        at scales up to the run's; after the stream, `refine(t)` goes below its last scale."""
         if not isinstance(n, (int, np.integer)) or isinstance(n, bool) or n < 0:
             raise ValueError(f"n = {n!r}: must be an int >= 0")
         x = ffi.new("double[3]")
