@@ -203,12 +203,15 @@ def main() -> None:
     n, sec, mem = vpds("tworadii", 2, 0.01, 0.5)
     row("libvpds 2D two radii R_f=0.5 R_c, r=0.01", n, sec, mem,
         note=f"time/sample = {(sec / n) / (s1 / n1):.1f}x one radius r=0.005")
-    # two radii with a variable radius in 3D (a fuzz input's workload): the coverage search that
-    # keeps what it learns (algorithm version 4) beside version 3's, the same points
-    n, sec, mem = vpds("tworamp3", 4)
+    # two radii with a variable radius in 3D (a fuzz input's workload): the coverage search of
+    # version 6 (what it learns, and the sub-boxes each cell keeps) beside version 3's (the same
+    # points) and beside one radius on that box (issue 14's target: 3x per sample)
+    n, sec, mem = vpds("tworamp3", 6)
     n3, s3, _ = vpds("tworamp3", 3)
-    row("libvpds 3D two radii, ramp, periodic (version 4)", n, sec, mem,
-        note=f"time = {sec / s3:.2f}x version 3's ({n3} samples, {s3:.2f} s)")
+    n1, s1, _ = vpds("tworamp3", 6, 1)
+    row("libvpds 3D two radii, ramp, periodic (version 6)", n, sec, mem,
+        note=f"time = {sec / s3:.2f}x version 3's ({n3} samples, {s3:.2f} s); "
+             f"time/sample = {(sec / n) / (s1 / n1):.1f}x one radius ({n1} samples)")
     # a domain: the annulus 0.2 <= |x - c| <= 0.45 by its signed distance, beside the full box
     r_a = 0.001 if QUICK else 0.0005
     n, sec, mem = vpds("annulus", r_a)
