@@ -119,13 +119,22 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         /* the samples are maximal at the last t: a run has nothing to add */
         i = vpds_mesh_count(s);
         FUZZ_ASSERT(vpds_mesh_run(s) == VPDS_OK && vpds_mesh_count(s) == i, "a run after the stream");
-        if ((mode & 4) && isfinite(last)) { /* a refine below it, through its pauses */
-            for (calls = 0; calls < 2000 && (st = vpds_mesh_refine(s, 0.8 * last)) == VPDS_PAUSED; calls++) {}
+        st = VPDS_ERR_STATE;
+        if ((mode & 4) && isfinite(last)) { /* a refine below it, through its pauses, and the stream again */
+            double t_ref = 0.8 * last;
+            for (calls = 0; calls < 2000 && (st = vpds_mesh_refine(s, t_ref)) == VPDS_PAUSED; calls++) {}
             check_status(st);
             FUZZ_ASSERT(st == VPDS_OK || st == VPDS_PAUSED || st == VPDS_ERR_OVERFLOW, "refine after the stream: "
                         "status %d: %s", (int)st, vpds_mesh_last_error(s));
+            for (calls = 0, last = t_ref; st == VPDS_OK && calls < 5; calls++) {
+                FUZZ_ASSERT(vpds_mesh_next(s, 0, x, &t) == VPDS_OK && t <= last, "stream after a refine: t %g after %g",
+                            t, last);
+                last = t;
+            }
+            /* probed at scale 1: covered there when covered at t_ref <= 1 (the disks only grow) */
+            st = st == VPDS_OK && t_ref <= 1 && vpds_mesh_get_stats(s).delta == 0 ? VPDS_OK : VPDS_ERR_STATE;
         }
-        check_run(s, v, tri, nt, d.vertex_radii, d.radius, d.rule, 0, VPDS_STREAM_TOLERANCE);
+        check_run(s, v, tri, nt, d.vertex_radii, d.radius, d.rule, st == VPDS_OK, VPDS_STREAM_TOLERANCE);
         vpds_mesh_destroy(s);
         return 0;
     }

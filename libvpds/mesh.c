@@ -28,6 +28,8 @@ struct vpds_mesh {
     vpdsi_surface surface;
     vpdsi_surface_marks marks;
     vpdsi_surface_stream stream;   /* in use once vpds_mesh_next was called */
+    double run_t;                  /* the scale of the last run completed (+INFINITY: none): the
+                                      stream after it reports no scale above it */
     vpdsi_rng rng;
     vpds_stats stats;
     vpds_rule rule;
@@ -308,6 +310,7 @@ vpds_status vpds_mesh_create(const vpds_mesh_desc *d, vpds_mesh **out)
     s->rule = vpdsi_rule_resolve(d->rule);
     s->coverage = d->coverage;
     s->budget = d->budget;
+    s->run_t = INFINITY;
     s->progress = d->progress;
     s->progress_user = d->progress_user;
     vpdsi_rng_seed(&s->rng, d->seed);
@@ -361,11 +364,13 @@ static vpds_status mesh_work(vpds_mesh *s)
 {
     vpdsi_surface_ctx c = mesh_context(s);
     size_t before = s->store.n;
+    int was_done = s->surface.phase == VPDSI_SURF_DONE;
     vpds_status e;
     s->store.err[0] = 0;
     e = vpdsi_surface_run(&s->surface, &c);
     /* a run after a stream: the stream's best point seen is stale once samples are added */
     if (s->store.n != before) s->stream.best.g = -1;
+    if (e == VPDS_OK && !was_done) s->run_t = s->surface.t;
     return e;
 }
 
@@ -379,11 +384,11 @@ vpds_status vpds_mesh_run(vpds_mesh *s)
 vpds_status vpds_mesh_refine(vpds_mesh *s, double t)
 {
     if (!live(s)) return VPDS_ERR_INVALID_ARGUMENT;
-    if (s->surface.phase != VPDSI_SURF_IDLE && t == s->surface.t) return mesh_work(s);
     if (!isfinite(t) || !vpdsi_scale_ok(t * s->coverage)) {
         vpdsi_store_error(&s->store, "t = %g: must be finite, > 0, with t * coverage within [1e-50, 1e50]", t);
         return VPDS_ERR_INVALID_ARGUMENT;
     }
+    if (s->surface.phase != VPDSI_SURF_IDLE && t == s->surface.t) return mesh_work(s);
     if (s->surface.phase != VPDSI_SURF_IDLE && s->surface.phase != VPDSI_SURF_DONE) {
         vpdsi_store_error(&s->store, "refine to t = %g: the run at t = %g is not complete (call it "
                           "again until VPDS_OK first)", t, s->surface.t);
@@ -418,8 +423,7 @@ vpds_status vpds_mesh_next(vpds_mesh *s, double t_min, double *x_out, double *t_
     }
     c = mesh_context(s);
     s->store.err[0] = 0;
-    e = vpdsi_surface_next(&s->stream, &c, t_min,
-                           s->surface.phase == VPDSI_SURF_DONE ? s->surface.t : INFINITY, x_out, t_out);
+    e = vpdsi_surface_next(&s->stream, &c, t_min, s->run_t, x_out, t_out);
     /* the samples are maximal at t (Section 4.2): a later refine goes below it */
     if (e == VPDS_OK) vpdsi_surface_done_at(&s->surface, &s->mem, *t_out);
     return e;

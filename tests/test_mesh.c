@@ -915,52 +915,85 @@ static size_t stream_conflicts(const vpds_mesh *s, vpds_rule rule)
 }
 
 /* Runs and streams mix as on a box: a stream continued after a run (its scales at most the
- * run's, each prefix covered at its t), a refine after a stream (maximal at its t), a stream
- * again after that; the same seed gives the same samples. */
-static void test_stream_mixing(void)
+ * run's and non-increasing, each prefix covered at its t), a refine after a stream (maximal at
+ * its t), the stream again after that, also after a call that searched and returned
+ * VPDS_STREAM_END (the best point it saw goes stale once the refine adds samples); every pair
+ * within the stream's promise; the same calls give the same samples. */
+static void mixing_case(const char *what, const mesh_t *m, const double *vr, radius_fn rf, vpds_rule rule,
+                        double radius, double r_min, double r_max, vpds_mesh **out)
 {
-    mesh_t sphere = icosphere(3);
-    vpds_mesh_desc d = desc_for(&sphere);
-    vpds_mesh *a = NULL, *b = NULL;
+    vpds_mesh_desc d = desc_for(m);
+    vpds_mesh *a = NULL;
     double x[3], t, last = 1.0, t_ref;
-    size_t k, n_run, bad_t = 0;
-    vpds_rule rule = VPDS_RULE_SMALLER;
-    d.radius = r_const_val = 0.3;
+    size_t k, n_run, bad_t = 0, steps = quick ? 6 : 10;
+    d.radius = r_const_val = radius;
+    d.vertex_radii = vr;
+    d.rule = rule;
     d.seed = 11;
-    /* a run at t = 1, then the stream: t <= 1, non-increasing, each prefix covered at its t */
-    if (vpds_mesh_create(&d, &a) != VPDS_OK || vpds_mesh_run(a) != VPDS_OK) { CHECK(0); return; }
+    *out = NULL;
+    if (vpds_mesh_create(&d, &a) != VPDS_OK) { CHECK(0); return; }
+    if (vpds_mesh_run(a) != VPDS_OK) { CHECK(0); vpds_mesh_destroy(a); return; }
     n_run = vpds_mesh_count(a);
     for (k = 0; k < 30; k++) {
         CHECK(vpds_mesh_next(a, 0, x, &t) == VPDS_OK);
         bad_t += !(t <= last);
         last = t;
         if (k % 10 == 9)
-            CHECK_MSG(uncovered_probes(&sphere, NULL, r_const, rule, t, vpds_mesh_points(a), vpds_mesh_radii(a),
-                                       vpds_mesh_count(a) - 1, quick ? 6 : 10) == 0,
-                      "stream after a run: the prefix before event %zu does not cover at its t %g", k, t);
+            CHECK_MSG(uncovered_probes(m, vr, rf, rule, t, vpds_mesh_points(a), vpds_mesh_radii(a),
+                                       vpds_mesh_count(a) - 1, (int)steps) == 0,
+                      "%s: stream after a run: the prefix before event %zu does not cover at its t %g", what, k, t);
     }
-    CHECK_MSG(bad_t == 0 && vpds_mesh_count(a) == n_run + 30, "stream after a run: %zu scales out of order", bad_t);
-    CHECK_MSG(stream_conflicts(a, rule) == 0, "stream after a run: pairs in conflict");
-    /* a refine below the last event: maximal there, every pair kept apart */
-    t_ref = 0.7 * last;
-    CHECK(vpds_mesh_refine(a, t_ref) == VPDS_OK && vpds_mesh_count(a) > n_run + 30);
+    CHECK_MSG(bad_t == 0 && vpds_mesh_count(a) == n_run + 30, "%s: stream after a run: %zu scales out of order",
+              what, bad_t);
+    CHECK_MSG(stream_conflicts(a, rule) == 0, "%s: stream after a run: pairs in conflict", what);
+    /* events down to 0.97 last, then a call that searches and ends; a refine below: maximal */
+    t_ref = 0.97 * last;
+    while (vpds_mesh_next(a, t_ref, x, &t) == VPDS_OK) last = t;
+    t_ref = 0.9 * last;
+    CHECK(vpds_mesh_refine(a, t_ref) == VPDS_OK && vpds_mesh_get_stats(a).maximal);
     {
-        report_t rep = check_mesh_run(a, &sphere, NULL, r_const, rule, t_ref, 0.3, 0.3);
-        CHECK_MSG(rep.uncovered == 0 && rep.off_surface == 0, "refine after a stream: %zu of %zu probes uncovered",
-                  rep.uncovered, rep.probes);
-        CHECK(stream_conflicts(a, rule) == 0);
+        report_t rep = check_mesh_run(a, m, vr, rf, rule, t_ref, r_min, r_max);
+        CHECK_MSG(rep.uncovered == 0 && rep.off_surface == 0 && rep.bad_radius == 0,
+                  "%s: refine after a stream: %zu of %zu probes uncovered", what, rep.uncovered, rep.probes);
     }
-    /* the stream again, below the refine's scale */
-    CHECK(vpds_mesh_next(a, 0, x, &t) == VPDS_OK && t <= t_ref);
-    CHECK(stream_conflicts(a, rule) == 0);
-    /* the same calls, the same samples */
-    if (vpds_mesh_create(&d, &b) == VPDS_OK && vpds_mesh_run(b) == VPDS_OK) {
-        for (k = 0; k < 30; k++) CHECK(vpds_mesh_next(b, 0, x, &t) == VPDS_OK);
-        CHECK(vpds_mesh_refine(b, t_ref) == VPDS_OK && vpds_mesh_next(b, 0, x, &t) == VPDS_OK);
-        CHECK(same_samples(a, b));
+    /* the stream again, below the refine's scale, each prefix covered at its t */
+    last = t_ref;
+    for (k = 0; k < 12; k++) {
+        CHECK(vpds_mesh_next(a, 0, x, &t) == VPDS_OK);
+        bad_t += !(t <= last);
+        last = t;
     }
+    CHECK_MSG(bad_t == 0, "%s: stream after a refine: scales out of order", what);
+    CHECK_MSG(uncovered_probes(m, vr, rf, rule, t, vpds_mesh_points(a), vpds_mesh_radii(a), vpds_mesh_count(a) - 1,
+                               (int)steps) == 0, "%s: stream after a refine: the last prefix does not cover", what);
+    CHECK_MSG(stream_conflicts(a, rule) == 0, "%s: pairs in conflict after run, stream, refine, stream", what);
+    *out = a;
+}
+
+static void test_stream_mixing(void)
+{
+    mesh_t sphere = icosphere(3);
+    double *vr = (double *)malloc(sphere.nv * sizeof(double));
+    vpds_mesh *a, *b;
+    size_t i;
+    for (i = 0; i < sphere.nv; i++) vr[i] = 0.3 + 0.1 * sphere.v[3 * i + 2];
+    mixing_case("mixing, constant radius", &sphere, NULL, r_const, VPDS_RULE_SMALLER, 0.3, 0.3, 0.3, &a);
+    mixing_case("mixing, constant radius again", &sphere, NULL, r_const, VPDS_RULE_SMALLER, 0.3, 0.3, 0.3, &b);
+    CHECK(a && b && same_samples(a, b));
     vpds_mesh_destroy(a);
     vpds_mesh_destroy(b);
+    mixing_case("mixing, vertex radii, bigger", &sphere, vr, r_vertex, VPDS_RULE_BIGGER, 0, 0.2, 0.4, &a);
+    vpds_mesh_destroy(a);
+    /* an infinite scale is refused even where it equals the current one (after the first event) */
+    {
+        vpds_mesh_desc d = desc_for(&sphere);
+        double x[3], t;
+        d.radius = 0.3;
+        CHECK(vpds_mesh_create(&d, &a) == VPDS_OK && vpds_mesh_next(a, 0, x, &t) == VPDS_OK && t == INFINITY);
+        CHECK(vpds_mesh_refine(a, INFINITY) == VPDS_ERR_INVALID_ARGUMENT && vpds_mesh_count(a) == 1);
+        vpds_mesh_destroy(a);
+    }
+    free(vr);
     mesh_free(&sphere);
 }
 
@@ -986,7 +1019,7 @@ static void test_stream(void)
     CHECK(vpds_mesh_create(&d, &a) == VPDS_OK && vpds_mesh_create(&d, &b) == VPDS_OK);
     for (i = 0; i < 40; i++) CHECK(vpds_mesh_next(a, 0, x, &t) == VPDS_OK);
     CHECK(vpds_mesh_next(a, 1e9, x, &t) == VPDS_STREAM_END && vpds_mesh_count(a) == 40);
-    CHECK(vpds_mesh_next(a, t, xa, &ta) == VPDS_STREAM_END); /* t: the 40th's, above the 41st's */
+    CHECK(vpds_mesh_next(a, t, xa, &ta) == VPDS_STREAM_END); /* t_min: the 40th's t, not below the 41st's */
     CHECK(vpds_mesh_next(a, 0, xa, &ta) == VPDS_OK && ta <= t);
     for (i = 0; i < 41; i++) CHECK(vpds_mesh_next(b, 0, x, &t) == VPDS_OK);
     CHECK(memcmp(x, xa, sizeof x) == 0 && t == ta && same_samples(a, b));
