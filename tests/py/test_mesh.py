@@ -207,9 +207,23 @@ def test_cli_samples_a_mesh_file_into_ply(tmp_path):
     np.testing.assert_allclose(api.points, table[:, :3], rtol=0, atol=0)
 
 
+def test_cli_streams_exactly_n_points_on_a_mesh(tmp_path):
+    trimesh.creation.icosphere(subdivisions=2).export(tmp_path / "ball.stl")
+    res = vpds_cli("sample", "--mesh", "ball.stl", "--radius", "0.2", "--seed", "3", "--stream", "57",
+                   "-o", "s.ply", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.startswith("57 samples on ball.stl")
+    head, body = (tmp_path / "s.ply").read_text().split("end_header\n")
+    table = np.loadtxt(body.splitlines(), ndmin=2)
+    m = trimesh.load(tmp_path / "ball.stl", force="mesh", process=False)
+    api = vpds.sample_mesh(m, radius=0.2, n=57, rng=3)
+    np.testing.assert_allclose(api.points, table[:, :3], rtol=0, atol=0)
+
+
 @pytest.mark.parametrize("args, message", [
     (["--mesh", "no-such.obj"], "--mesh no-such.obj: no such file"),
-    (["--mesh", "m.stl", "--stream", "5"], "--stream is not available with --mesh"),
+    (["--mesh", "m.stl", "--stream", "5", "--refine", "0.5"], "--stream with --refine"),
+    (["--mesh", "m.stl", "--periodic", "0"], "--periodic is not available with --mesh"),
     (["--mesh", "m.stl", "--dim", "3"], "--dim is not available with --mesh"),
     (["--mesh", "m.stl", "--radius", "-1"], "desc.radius = -1"),
     (["--mesh", "m.stl", "-o", "out.vtk"], "unsupported extension '.vtk'"),

@@ -1,7 +1,8 @@
 """`vpds sample --mesh FILE`: a maximal sampling of a triangle mesh's surface (vpds.mesh), the
 mesh read through trimesh (OBJ, PLY, STL, OFF, GLB, ...). The box options that have a meaning
 on a surface keep it (--radius, --sizing in x = (x0, x1, x2) with --lipschitz, --rule,
---coverage, --refine, --seed, -o, --plot); the others are refused."""
+--coverage, --refine, --stream N: exactly N points from the stream on the surface, --seed, -o,
+--plot); the others are refused."""
 from __future__ import annotations
 
 import argparse
@@ -15,8 +16,8 @@ from .cli_common import UsageError, sizing_from_expression
 from .files import check_output, write_points
 
 # box-only options and the defaults that mean "not given"
-_BOX_ONLY = {"stream": None, "periodic": None, "domain": None, "sizing_exr": None, "lo": None,
-             "hi": None, "tiles": None}
+_BOX_ONLY = {"periodic": None, "domain": None, "sizing_exr": None, "lo": None, "hi": None,
+             "tiles": None}
 
 
 def add_mesh_arguments(s: argparse.ArgumentParser) -> None:
@@ -46,6 +47,11 @@ def cmd_sample_mesh(args: argparse.Namespace) -> int:
             raise UsageError(f"--{name.replace('_', '-')} is not available with --mesh")
     if args.dim != 2:
         raise UsageError("--dim is not available with --mesh (a surface in 3D)")
+    if args.stream is not None and args.stream < 0:
+        raise UsageError(f"--stream {args.stream}: must be >= 0")
+    if args.stream and args.refine:
+        raise UsageError("--stream with --refine: the stream gives the points and their scales; "
+                         "use one or the other")
     if args.output:
         check_output(Path(args.output), 3)
     if args.plot:
@@ -57,17 +63,23 @@ def cmd_sample_mesh(args: argparse.Namespace) -> int:
                           rule=args.rule, inhibition=args.inhibition, coverage=args.coverage,
                           rng=args.seed)
     t0 = time.perf_counter()
-    sampler.run()
-    for t in refine:
-        sampler.refine(t)
+    if args.stream:
+        sampler.progressive(args.stream)  # exactly N points, each prefix maximal at its scale
+    else:
+        sampler.run()
+        for t in refine:
+            sampler.refine(t)
     seconds = time.perf_counter() - t0
     s = sampler.samples
     what = f"r = {args.sizing}" if args.sizing else f"radius {args.radius}"
     print(f"{len(s.points)} samples on {args.mesh} ({len(faces)} triangles; {what}, rule {args.rule}, "
           f"seed {args.seed}) in {seconds:.3f} s; maximal: {s.maximal}")
     if args.output:
+        from . import STREAM_TOLERANCE
         meta = dict(mesh=str(args.mesh), rule=args.rule, seed=args.seed, coverage=args.coverage,
                     inhibition=args.inhibition, refine=refine, complete=True,
+                    mode="stream" if args.stream else "refine" if refine else "run",
+                    **({"stream_tolerance": STREAM_TOLERANCE} if args.stream else {}),
                     **({"sizing": args.sizing, "lipschitz": args.lipschitz} if args.sizing
                        else {"radius": args.radius}))
         write_points(Path(args.output), s.points, s.radii, s.scales, np.zeros(len(s.points), bool), meta,
