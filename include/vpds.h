@@ -52,8 +52,9 @@ extern "C" {
  * tolerance (a variable radius, a domain) keeps its open boxes in a heap, which splits them in
  * another order where bounds tie (other points for vpds_next; the runs give the points of
  * version 4). 6: with two radii each cell a dart asks about keeps which of its sub-boxes its
- * searches showed covered, and later questions and the sweep skip them (other points with two
- * radii, where the search's box budget decided). */
+ * searches showed covered, later questions and the sweep skip them, and a search visits a box's
+ * children from the one farthest from the dart (other points with two radii, where the search's
+ * box budget decided). */
 #define VPDS_ALGORITHM_VERSION 6
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 16

@@ -45,6 +45,7 @@ typedef struct {
     uint64_t sub_now; /* where sub points: written back only when the search ends without an
                          error, so that a retried dart takes the same boxes as the first try */
     int sub_depth;
+    int far_first;    /* version 6: a box's children from the farthest from the anchor on */
     vpdsi_kd_samples view, uview;
     bb_lists lv[UNCOVERED_DEPTH + 1];
     /* the box being examined: kept here, not in the helpers' frames, which then cost nothing
@@ -356,6 +357,12 @@ static vpds_status search(bb_search *q, int *found)
         }
         b = (unsigned)left - 1;
         FRAME_LEFT(bx, d) = b;
+        if (q->far_first) { /* the first child made is the one farthest from the anchor */
+            unsigned far = 0;
+            for (k = 0; k < d; k++)
+                if (q->centre[k] < 0.5 * (bx[k] + bx[d + k])) far |= 1u << k;
+            b ^= far ^ ((1u << d) - 1);
+        }
         cb = stack + top++ * stride;
         for (k = 0; k < d; k++) {
             double mid = 0.5 * (bx[k] + bx[d + k]);
@@ -394,6 +401,7 @@ static vpds_status prepare(bb_search *q, vpdsi_uncovered *u, const vpdsi_ctx *ct
     q->L = st->sizing.lipschitz;
     q->point = memcmp(alo, ahi, (size_t)d * sizeof(double)) == 0;
     q->exact_region = pb->algorithm >= 2;
+    q->far_first = pb->algorithm >= 6;
     q->budget = VPDSI_UNCOVERED_BUDGET;
     /* largest reach of the region: r(u) <= r_anchor + L |u - a| and |u - a| <= scale r(u) */
     q->reach = vpdsi_rule_reach(pb->rule, q->scale, q->L, r_anchor);
