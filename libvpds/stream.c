@@ -53,13 +53,17 @@ static double rec_key(const uint64_t *r)
     return k;
 }
 
-static void rec_swap(uint64_t *a, uint64_t *b, size_t w)
+/* Swaps two records of w 8-byte words (the region heap's uint64_t, the box heap's doubles). */
+static void words_swap(void *a, void *b, size_t w)
 {
+    unsigned char *p = (unsigned char *)a, *q = (unsigned char *)b;
     size_t i;
-    for (i = 0; i < w; i++) {
-        uint64_t t = a[i];
-        a[i] = b[i];
-        b[i] = t;
+    for (i = 0; i < w * sizeof(uint64_t); i += sizeof(uint64_t)) { /* word by word, as memcpy */
+        uint64_t x, y;
+        memcpy(&x, p + i, sizeof x);
+        memcpy(&y, q + i, sizeof y);
+        memcpy(p + i, &y, sizeof y);
+        memcpy(q + i, &x, sizeof x);
     }
 }
 
@@ -78,7 +82,7 @@ static void heap_push(vpdsi_stream *sm, double key, uint64_t level, const uint64
     while (i > 0) {
         size_t p = (i - 1) / 2;
         if (!(rec_key(sm->heap + p * w) < rec_key(sm->heap + i * w))) break;
-        rec_swap(sm->heap + p * w, sm->heap + i * w, w);
+        words_swap(sm->heap + p * w, sm->heap + i * w, w);
         i = p;
     }
 }
@@ -96,7 +100,7 @@ static void heap_pop(vpdsi_stream *sm, uint64_t *out)
         if (l < n && rec_key(sm->heap + l * w) > rec_key(sm->heap + m * w)) m = l;
         if (r < n && rec_key(sm->heap + r * w) > rec_key(sm->heap + m * w)) m = r;
         if (m == i) break;
-        rec_swap(sm->heap + m * w, sm->heap + i * w, w);
+        words_swap(sm->heap + m * w, sm->heap + i * w, w);
         i = m;
     }
 }
@@ -260,23 +264,13 @@ typedef struct {
  * Versions 1-4 scan a list for the first largest bound: the same boxes are split, in another
  * order where bounds tie; a flat maximum leaves tens of thousands open, and the scan of each
  * split was most of such a search's time. */
-static void box_swap(double *a, double *b, size_t w)
-{
-    size_t i;
-    for (i = 0; i < w; i++) {
-        double t = a[i];
-        a[i] = b[i];
-        b[i] = t;
-    }
-}
-
 static void box_sift_up(vpdsi_stream *sm, size_t i)
 {
     size_t w = 1 + 2 * (size_t)sm->geom.dim;
     while (i > 0) {
         size_t p = (i - 1) / 2;
         if (!(sm->boxes[p * w] < sm->boxes[i * w])) break;
-        box_swap(sm->boxes + p * w, sm->boxes + i * w, w);
+        words_swap(sm->boxes + p * w, sm->boxes + i * w, w);
         i = p;
     }
 }
@@ -289,7 +283,7 @@ static void box_sift_down(vpdsi_stream *sm, size_t i)
         if (l < n && sm->boxes[l * w] > sm->boxes[m * w]) m = l;
         if (r < n && sm->boxes[r * w] > sm->boxes[m * w]) m = r;
         if (m == i) return;
-        box_swap(sm->boxes + m * w, sm->boxes + i * w, w);
+        words_swap(sm->boxes + m * w, sm->boxes + i * w, w);
         i = m;
     }
 }

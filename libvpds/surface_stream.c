@@ -209,11 +209,10 @@ vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx
                                double t_min, double t_max, double *x_out, double *t_out)
 {
     vpdsi_surface_best *best = &ss->best;
-    vpds_status e0;
+    vpds_status e;
     /* a run may have filed its samples in another index: the bounds read the kd-tree */
-    if ((e0 = vpdsi_store_sync_tree(ctx->st)) != VPDS_OK) return e0;
+    if ((e = vpdsi_store_sync_tree(ctx->st)) != VPDS_OK) return e;
     if (!ss->started) {
-        vpds_status e;
         if (ctx->st->n == 0) return first_surface_sample(ss, ctx, x_out, t_out);
         /* after a run: the search starts from its samples */
         if ((e = reserve_heap(ss, ctx)) != VPDS_OK) return e;
@@ -221,8 +220,7 @@ vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx
     }
     for (;;) {
         double ub, t;
-        vpds_status e = piece_upper_bound(ctx, &ss->heap[0].p, &ub);
-        if (e != VPDS_OK) return e;
+        if ((e = piece_upper_bound(ctx, &ss->heap[0].p, &ub)) != VPDS_OK) return e;
         if (ub < ss->heap[0].ub) {
             /* a sample came nearer since the bound was taken: it falls back in the heap */
             ss->heap[0].ub = ub;

@@ -273,14 +273,6 @@ static void first_box(bb_search *q, double *bx)
     bx[2 * d] = 0;
 }
 
-/* Version 6: the bits of q->sub of the box at `depth` whose first sub-box at q->sub_depth is
- * `first` (its sub-boxes are consecutive: the first halving is the most significant). */
-static uint64_t sub_bits(const bb_search *q, int depth, unsigned first)
-{
-    unsigned n = 1u << ((unsigned)q->pb->dim * (unsigned)(q->sub_depth - depth));
-    return (n >= 64 ? ~UINT64_C(0) : (UINT64_C(1) << n) - 1) << first;
-}
-
 /* A frame of the search's stack: the box (dim lows, dim highs), its depth, how many of its 2^d
  * children are still to visit (-1: the box itself is not examined yet), its first sub-box of
  * q->sub (version 6) and whether every box below it was dropped for good so far. */
@@ -297,7 +289,7 @@ static vpds_status visit(bb_search *q, double *bx, size_t *boxes, int *found, in
     unsigned first = (unsigned)FRAME_SUB(bx, d);
     double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
     if (q->sub && depth <= q->sub_depth) {
-        uint64_t bits = sub_bits(q, depth, first);
+        uint64_t bits = vpdsi_sub_run(d, q->sub_depth - depth, first);
         if ((*q->sub & bits) == bits) { /* shown covered by an earlier question of this scale */
             *verdict = 0;
             q->drop_kept = 1;
@@ -321,7 +313,7 @@ static void frame_done(bb_search *q, double *bx, double *parent)
     if (FRAME_KEPT(bx, d) == 0) {
         if (parent) FRAME_KEPT(parent, d) = 0;
     } else if (q->sub && depth <= q->sub_depth) {
-        *q->sub |= sub_bits(q, depth, (unsigned)FRAME_SUB(bx, d));
+        *q->sub |= vpdsi_sub_run(d, q->sub_depth - depth, (unsigned)FRAME_SUB(bx, d));
     }
 }
 

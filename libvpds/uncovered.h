@@ -68,6 +68,17 @@ static inline vpdsi_kd_samples vpdsi_uncovered_view(const vpdsi_uncovered *u)
     return v;
 }
 
+/* Version 6's sub-box bits: halvings kept per cell in dimension d (64 bits hold 2^(d * depth)
+ * sub-boxes; 0: none kept), and the run of bits of a box `levels` halvings above them whose
+ * first sub-box is `first` (a box's sub-boxes are consecutive: the first halving is the most
+ * significant digit of their number). */
+static inline int vpdsi_sub_depth(int d) { return d >= 1 && d <= 6 ? 6 / d : 0; }
+static inline uint64_t vpdsi_sub_run(int d, int levels, unsigned first)
+{
+    unsigned n = 1u << ((unsigned)d * (unsigned)levels);
+    return (n >= 64 ? ~UINT64_C(0) : (UINT64_C(1) << n) - 1) << first;
+}
+
 void vpdsi_uncovered_init(vpdsi_uncovered *u, int dim, const double *period);
 void vpdsi_uncovered_release(vpdsi_uncovered *u, vpdsi_mem *m);
 

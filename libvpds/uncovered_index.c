@@ -59,15 +59,12 @@ static int reserve_index(vpdsi_uncovered *u, vpdsi_mem *mem, int d, size_t m, si
            vpdsi_mem_reserve(mem, (void **)&u->state, &u->cap_state, m + 1, 1) ||
            vpdsi_mem_reserve(mem, (void **)&u->centre_of, &u->cap_centre_of, n + 1, sizeof(int32_t)) ||
            vpdsi_mem_reserve(mem, (void **)&u->nwit, &u->cap_nwit, nw, sizeof(double)) ||
-           (learn > 1 && d <= 6 && vpdsi_mem_reserve(mem, (void **)&u->sub, &u->cap_sub, m + 1, sizeof(uint64_t)));
+           (learn > 1 && vpdsi_sub_depth(d) > 0 &&
+            vpdsi_mem_reserve(mem, (void **)&u->sub, &u->cap_sub, m + 1, sizeof(uint64_t)));
 }
 
-/* Every sub-box of a cell: the 2^(dim * sub_depth) low bits. */
-static uint64_t all_sub(const vpdsi_uncovered *u, int d)
-{
-    unsigned n = 1u << ((unsigned)d * (unsigned)u->sub_depth);
-    return n >= 64 ? ~UINT64_C(0) : (UINT64_C(1) << n) - 1;
-}
+/* Every sub-box of a cell. */
+static uint64_t all_sub(const vpdsi_uncovered *u, int d) { return vpdsi_sub_run(d, u->sub_depth, 0); }
 
 vpds_status vpdsi_uncovered_index(vpdsi_uncovered *u, vpdsi_store *st, const vpdsi_cells *next,
                                   const vpdsi_lattice *g, int learn)
@@ -96,8 +93,7 @@ vpds_status vpdsi_uncovered_index(vpdsi_uncovered *u, vpdsi_store *st, const vpd
     }
     u->n_nwit = 0;
     u->learn = learn;
-    /* 64 bits hold the sub-boxes of sub_depth halvings when dim * sub_depth <= 6 */
-    u->sub_depth = learn > 1 && d <= 6 ? 6 / d : 0;
+    u->sub_depth = learn > 1 ? vpdsi_sub_depth(d) : 0;
     u->n_centre_of = learn ? next->count : 0;
     u->half = 0;
     v = vpdsi_uncovered_view(u);
@@ -169,14 +165,13 @@ static const double *live_witness(vpdsi_uncovered *u, const vpdsi_ctx *ctx, doub
 
 int vpdsi_uncovered_child_covered(const vpdsi_uncovered *u, size_t pos, int d, int split, unsigned child)
 {
-    unsigned n;
     uint64_t bits;
     int32_t m;
     if (!vpdsi_uncovered_indexed(u, pos) || u->sub_depth == 0) return 0;
     m = u->centre_of[pos];
     if (!split) return u->sub[m] == all_sub(u, d);
-    n = 1u << ((unsigned)d * (unsigned)(u->sub_depth - 1)); /* a child's sub-boxes, consecutive */
-    bits = (n >= 64 ? ~UINT64_C(0) : (UINT64_C(1) << n) - 1) << (child * n);
+    /* child c's sub-boxes start at c times their count */
+    bits = vpdsi_sub_run(d, u->sub_depth - 1, child << ((unsigned)d * (unsigned)(u->sub_depth - 1)));
     return (u->sub[m] & bits) == bits;
 }
 

@@ -1,7 +1,6 @@
 // Peer: the fast_poisson crate (Bridson's algorithm) on [0, 1]^d with radius r.
 // usage: vpds-bench-fast-poisson DIM RADIUS SEED [OUT] -> "n seconds"; OUT: the points as text
 use fast_poisson::Poisson;
-use std::io::Write;
 use std::time::Instant;
 
 // The points as rows, and the seconds the generator took (the copy into rows is not timed)
@@ -25,11 +24,7 @@ fn main() {
         _ => panic!("dim"),
     };
     if let Some(path) = args.get(4) {
-        let mut out = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
-        for p in &pts {
-            let line: Vec<String> = p.iter().map(|c| format!("{:e}", c)).collect();
-            writeln!(out, "{}", line.join(" ")).unwrap();
-        }
+        vpds_bench_fast_poisson::write_points(path, &pts);
     }
     println!("{} {}", pts.len(), seconds);
 }

@@ -4,7 +4,6 @@
 use poisson::{algorithm, Builder, Type};
 use rand::rngs::SmallRng;
 use rand::SeedableRng;
-use std::io::Write;
 use std::time::Instant;
 
 // One run at dimension $dim with the crate's vector type $v: the points as rows, and the
@@ -31,11 +30,7 @@ fn main() {
         _ => panic!("dim must be 2, 3 or 4"),
     };
     if let Some(path) = args.get(4) {
-        let mut out = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
-        for p in &points {
-            let line: Vec<String> = p.iter().map(|c| format!("{:e}", c)).collect();
-            writeln!(out, "{}", line.join(" ")).unwrap();
-        }
+        vpds_bench_fast_poisson::write_points(path, &points);
     }
     println!("{} {}", points.len(), seconds);
 }
