@@ -68,15 +68,18 @@ static void check_status(vpds_status st)
 
 /* The samples so far: finite, r > 0, inside the box unless fixed, and no sample conflicts with
  * one before it (Eq. 10, with the radii the library recorded and each sample's scale). */
-static void check_samples_on(const vpds_sampler *s, const double *lo, const double *hi,
-                             vpds_rule rule, double inhibition, const int *periodic)
+/* Samples `from` on (each against every earlier one) are finite, in the box unless fixed, and
+ * conflict-free under the rule; a harness that checked the earlier ones passes what it checked. */
+static void check_samples_since(const vpds_sampler *s, size_t from, const double *lo,
+                                const double *hi, vpds_rule rule, double inhibition,
+                                const int *periodic)
 {
     size_t n = vpds_count(s), i, j;
     int d = vpds_dim(s), k;
     const double *x = vpds_points(s), *r = vpds_radii(s), *t = vpds_scales(s);
     const uint8_t *fl = vpds_flags(s);
     if (rule == VPDS_RULE_DEFAULT) rule = VPDS_RULE_SMALLER;
-    for (i = 0; i < n; i++) {
+    for (i = from; i < n; i++) {
         FUZZ_ASSERT(isfinite(r[i]) && r[i] > 0, "r[%zu] = %g", i, r[i]);
         for (k = 0; k < d; k++) {
             FUZZ_ASSERT(isfinite(x[i * d + k]), "x[%zu] not finite", i);
@@ -99,6 +102,46 @@ static void check_samples_on(const vpds_sampler *s, const double *lo, const doub
             FUZZ_ASSERT(d2 >= f * f, "sample %zu conflicts with %zu (%g < %g)", i, j, sqrt(d2), f);
         }
     }
+}
+
+static void check_samples_on(const vpds_sampler *s, const double *lo, const double *hi,
+                             vpds_rule rule, double inhibition, const int *periodic)
+{
+    check_samples_since(s, 0, lo, hi, rule, inhibition, periodic);
+}
+
+/* The samples a harness checked, kept to show that later calls leave them as they were (they
+ * only append), so that each call's check covers its new samples alone. */
+typedef struct {
+    double *copy; /* count * (dim + 2) doubles: coordinates, r, t */
+    size_t count;
+} checked_t;
+
+/* After a call: the kept samples unchanged, the new ones checked, then all of them kept. */
+static void check_new_samples(checked_t *c, const vpds_sampler *s, const double *lo,
+                              const double *hi, vpds_rule rule, double inhibition,
+                              const int *periodic)
+{
+    size_t n = vpds_count(s), i, w = (size_t)vpds_dim(s) + 2;
+    const double *x = vpds_points(s), *r = vpds_radii(s), *t = vpds_scales(s);
+    double *grown;
+    FUZZ_ASSERT(n >= c->count, "the count fell from %zu to %zu", c->count, n);
+    for (i = 0; i < c->count; i++) {
+        const double *k = c->copy + i * w;
+        FUZZ_ASSERT(memcmp(k, x + i * (w - 2), (w - 2) * sizeof(double)) == 0 && k[w - 2] == r[i] &&
+                    (k[w - 1] == t[i] || (isnan(k[w - 1]) && isnan(t[i]))),
+                    "sample %zu changed after it was checked", i);
+    }
+    check_samples_since(s, c->count, lo, hi, rule, inhibition, periodic);
+    grown = (double *)realloc(c->copy, (n ? n : 1) * w * sizeof(double));
+    FUZZ_ASSERT(grown != NULL, "out of memory keeping %zu samples", n);
+    c->copy = grown;
+    for (i = c->count; i < n; i++) {
+        memcpy(grown + i * w, x + i * (w - 2), (w - 2) * sizeof(double));
+        grown[i * w + w - 2] = r[i];
+        grown[i * w + w - 1] = t[i];
+    }
+    c->count = n;
 }
 
 static void check_samples(const vpds_sampler *s, const double *lo, const double *hi,

