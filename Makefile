@@ -112,11 +112,12 @@ check-flann: $(FLANN_TEST)
 
 # libFuzzer harnesses (clang; the library instrumented once for all of them) and the same
 # harnesses as plain programs that replay the corpus (gcc)
-# The library gets libFuzzer's edge coverage but not its comparison tracing: UBSan's own null and
-# alignment checks on every pointer read are integer comparisons, and tracing them took 76% of
-# the time of the slow two-radii inputs (fuzz/corpus/sequence/two-radii-*: 15.7 s, 4.8 s without).
-# The harnesses, which decode the input, keep it (-fsanitize=fuzzer); in 60 s from the seeds both
-# builds reach the same edges (2025 and 2021) and this one runs 1.5x the inputs.
+# The library gets libFuzzer's edge coverage but not its comparison tracing: UBSan's
+# pointer-overflow and alignment checks on every indexed read are integer comparisons, and
+# tracing them took 76% of the time of the slow two-radii inputs (fuzz/slow/sequence: 15.7 s and
+# 24.6 s, 4.7 s and 6.5 s without). The harnesses, which decode the input, keep it
+# (-fsanitize=fuzzer); in 60 s from the seeds both builds reach the same edges (2025 and 2021)
+# and this one runs 1.5x the inputs.
 $(BUILD)/fuzz/obj/%.o: libvpds/%.c $(LIB_HDR)
 	@mkdir -p $(dir $@)
 	clang $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link -fno-sanitize-coverage=trace-cmp -c $< -o $@

@@ -66,10 +66,9 @@ static void check_status(vpds_status st)
     FUZZ_ASSERT(strncmp(vpds_status_string(st), "VPDS_", 5) == 0, "status %d has no name", (int)st);
 }
 
-/* The samples so far: finite, r > 0, inside the box unless fixed, and no sample conflicts with
- * one before it (Eq. 10, with the radii the library recorded and each sample's scale). */
-/* Samples `from` on (each against every earlier one) are finite, in the box unless fixed, and
- * conflict-free under the rule; a harness that checked the earlier ones passes what it checked. */
+/* Samples `from` on: finite, r > 0, inside the box unless fixed, and none conflicts with one
+ * before it (Eq. 10, with the radii the library recorded and each sample's scale); a harness
+ * that checked the earlier ones passes from = how many it checked. */
 static void check_samples_since(const vpds_sampler *s, size_t from, const double *lo,
                                 const double *hi, vpds_rule rule, double inhibition,
                                 const int *periodic)
@@ -104,6 +103,7 @@ static void check_samples_since(const vpds_sampler *s, size_t from, const double
     }
 }
 
+/* All the samples so far, as check_samples_since. */
 static void check_samples_on(const vpds_sampler *s, const double *lo, const double *hi,
                              vpds_rule rule, double inhibition, const int *periodic)
 {
@@ -113,34 +113,39 @@ static void check_samples_on(const vpds_sampler *s, const double *lo, const doub
 /* The samples a harness checked, kept to show that later calls leave them as they were (they
  * only append), so that each call's check covers its new samples alone. */
 typedef struct {
-    double *copy; /* count * (dim + 2) doubles: coordinates, r, t */
+    double *copy; /* count records of dim + 3 doubles: coordinates, r, t, flags */
     size_t count;
 } checked_t;
 
-/* After a call: the kept samples unchanged, the new ones checked, then all of them kept. */
+/* Sample i as a record of checked_t. */
+static void sample_record(const vpds_sampler *s, size_t i, double *rec)
+{
+    size_t d = (size_t)vpds_dim(s);
+    memcpy(rec, vpds_points(s) + i * d, d * sizeof(double));
+    rec[d] = vpds_radii(s)[i];
+    rec[d + 1] = vpds_scales(s)[i];
+    rec[d + 2] = (double)vpds_flags(s)[i];
+}
+
+/* After a call: the kept samples unchanged (bit for bit), the new ones checked, then all of
+ * them kept. */
 static void check_new_samples(checked_t *c, const vpds_sampler *s, const double *lo,
                               const double *hi, vpds_rule rule, double inhibition,
                               const int *periodic)
 {
-    size_t n = vpds_count(s), i, w = (size_t)vpds_dim(s) + 2;
-    const double *x = vpds_points(s), *r = vpds_radii(s), *t = vpds_scales(s);
-    double *grown;
+    size_t n = vpds_count(s), i, w = (size_t)vpds_dim(s) + 3;
+    double now[VPDS_MAX_DIM + 3], *grown;
     FUZZ_ASSERT(n >= c->count, "the count fell from %zu to %zu", c->count, n);
     for (i = 0; i < c->count; i++) {
-        const double *k = c->copy + i * w;
-        FUZZ_ASSERT(memcmp(k, x + i * (w - 2), (w - 2) * sizeof(double)) == 0 && k[w - 2] == r[i] &&
-                    (k[w - 1] == t[i] || (isnan(k[w - 1]) && isnan(t[i]))),
+        sample_record(s, i, now);
+        FUZZ_ASSERT(memcmp(now, c->copy + i * w, w * sizeof(double)) == 0,
                     "sample %zu changed after it was checked", i);
     }
     check_samples_since(s, c->count, lo, hi, rule, inhibition, periodic);
     grown = (double *)realloc(c->copy, (n ? n : 1) * w * sizeof(double));
     FUZZ_ASSERT(grown != NULL, "out of memory keeping %zu samples", n);
     c->copy = grown;
-    for (i = c->count; i < n; i++) {
-        memcpy(grown + i * w, x + i * (w - 2), (w - 2) * sizeof(double));
-        grown[i * w + w - 2] = r[i];
-        grown[i * w + w - 1] = t[i];
-    }
+    for (i = c->count; i < n; i++) sample_record(s, i, grown + i * w);
     c->count = n;
 }
 

@@ -33,15 +33,26 @@ for c in "abort crash deadly signal" "leak leak LeakSanitizer" "hang timeout tim
     fail "no $out/artifacts/$bad-$kind-* written (log $log)"
   [ $status = 0 ] && echo "fuzz_fails: fuzz_$bad fails make fuzz; its input is in $(ls "$out/artifacts/$bad-$kind-"* | head -1)"
 done
-# the sanitized replay of fuzz/slow/ (make check-fuzz) fails on a crashing harness too
-mkdir -p "$out/inputs"
-printf 'xx' > "$out/inputs/one"  # fuzz_abort aborts on two bytes
-if bash fuzz/replay_sanitized.sh "$out/fuzz_abort" "$out/inputs" > "$out/replay_abort.log" 2>&1; then
-  fail "fuzz/replay_sanitized.sh exited 0 with fuzz_abort (log $out/replay_abort.log)"
-elif ! grep -q "deadly signal" "$out/replay_abort.log"; then
-  fail "fuzz/replay_sanitized.sh did not show fuzz_abort's report (log $out/replay_abort.log)"
-else
-  echo "fuzz_fails: fuzz_abort fails fuzz/replay_sanitized.sh"
+# the sanitized replay of fuzz/slow/ (make check-fuzz) fails on a harness that crashes, leaks or
+# hangs too, and on a directory without inputs
+mkdir -p "$out/inputs" "$out/no_inputs/sub"
+printf 'xx' > "$out/inputs/one" # the bad harnesses misbehave on two bytes
+for c in "abort deadly signal" "leak LeakSanitizer" "hang timeout after"; do
+  set -- $c
+  bad=$1
+  shift
+  what="$*"
+  log=$out/replay_$bad.log
+  if bash fuzz/replay_sanitized.sh "$out/fuzz_$bad" "$out/inputs" 2 > "$log" 2>&1; then
+    fail "fuzz/replay_sanitized.sh exited 0 with fuzz_$bad (log $log)"
+  elif ! grep -q "$what" "$log"; then
+    fail "fuzz/replay_sanitized.sh did not show fuzz_$bad's report (log $log)"
+  else
+    echo "fuzz_fails: fuzz_$bad fails fuzz/replay_sanitized.sh"
+  fi
+done
+if bash fuzz/replay_sanitized.sh "$out/fuzz_ok" "$out/no_inputs" > "$out/replay_none.log" 2>&1; then
+  fail "fuzz/replay_sanitized.sh exited 0 on a directory without inputs"
 fi
 [ "$(stray)" = "$before" ] || fail "artifacts written to the repository's root: $(stray)"
 exit $status
