@@ -106,6 +106,13 @@ static vpds_desc ramp_desc(uint64_t seed)
 }
 
 /* Run to completion; returns a malloc'd copy of the points and writes the count. */
+/* The disk of radius 0.45 around (0.5, 0.5) as a signed distance (negative inside). */
+static double disk_domain(const double *x, void *user)
+{
+    (void)user;
+    return sqrt((x[0] - 0.5) * (x[0] - 0.5) + (x[1] - 0.5) * (x[1] - 0.5)) - 0.45;
+}
+
 static double *run_copy(const vpds_desc *d, size_t *n)
 {
     vpds_sampler *s = NULL;
@@ -383,11 +390,12 @@ int main(void)
     }
 
     /* allocator: count the allocations of a run, then fail each one in turn (a variable-radius
-     * run on the kd-tree, a uniform one on the background grid, and two radii with a variable
-     * radius: the coverage search and what its index learns) */
+     * run on the kd-tree, a uniform one on the background grid, two radii with a variable
+     * radius: the coverage search and what its index learns, and a domain: the kd-tree the
+     * domain's search reads lags the grid and takes a level's samples in batches) */
     {
         int which;
-        for (which = 0; which < 3; which++) {
+        for (which = 0; which < 4; which++) {
             counting_alloc ca;
             vpds_sampler *s = NULL;
             size_t total, k, reached = 0, n_base, sites;
@@ -404,6 +412,11 @@ int main(void)
                 d.rule = VPDS_RULE_SMALLER;
                 d.inhibition = 0.5;
                 d.seed = 5;
+            } else if (which == 3) {
+                d = vpds_default_desc();
+                d.radius = quick ? 0.02 : 0.006; /* 20,000 samples: a few batches (valgrind: 1,800) */
+                d.domain = disk_domain;
+                d.seed = 9;
             }
             base = run_copy(&d, &n_base);
             d.allocator.alloc = ca_alloc;
@@ -442,10 +455,10 @@ int main(void)
             /* the grid's own allocations (stencil, cells, candidates) may fail without an error:
              * the run falls back to the kd-tree, with the same points as checked above; so may
              * the coverage search's candidate lists (its tests then read the kd-trees) */
-            CHECK(reached <= total && total - reached <= (which == 1 ? 5u : which == 2 ? 1u : 0u));
+            CHECK(reached <= total && total - reached <= (which == 1 || which == 3 ? 5u : which == 2 ? 1u : 0u));
             printf("allocation failure (%s): %zu allocations from %zu call sites (0: not counted in"
                    " this build), each failed once, %zu seen as VPDS_ERR_OUT_OF_MEMORY\n",
-                   which == 2 ? "ramp, two radii" : which ? "uniform, grid" : "ramp, kd-tree", total,
+                   which == 3 ? "uniform, a domain" : which == 2 ? "ramp, two radii" : which ? "uniform, grid" : "ramp, kd-tree", total,
                    sites, reached);
             free(base);
         }
