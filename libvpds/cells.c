@@ -49,7 +49,7 @@ void vpdsi_cells_layout(vpdsi_cells *c, int dim, const uint64_t *n0, unsigned le
         c->offset[k] = off;
         off += c->bits[k];
     }
-    c->words_per_cell = (off + 63) / 64;
+    c->words_per_cell = off <= 32 ? 0 : (off + 63) / 64;
     c->level = level;
     c->count = 0;
 }
@@ -57,8 +57,24 @@ void vpdsi_cells_layout(vpdsi_cells *c, int dim, const uint64_t *n0, unsigned le
 int vpdsi_cells_reserve(vpdsi_cells *c, vpdsi_mem *m, size_t cells)
 {
     size_t words;
-    if (vpdsi_mul_size(cells, c->words_per_cell, &words)) return -1;
+    if (c->words_per_cell == 0)
+        words = cells / 2 + cells % 2;
+    else if (vpdsi_mul_size(cells, c->words_per_cell, &words))
+        return -1;
     return vpdsi_mem_reserve(m, (void **)&c->words, &c->cap_words, words, sizeof *c->words);
+}
+
+/* The 32-bit cell i of a layout with words_per_cell 0. */
+static uint32_t half_get(const vpdsi_cells *c, size_t i)
+{
+    uint32_t v;
+    memcpy(&v, (const unsigned char *)c->words + i * sizeof v, sizeof v);
+    return v;
+}
+
+static void half_set(vpdsi_cells *c, size_t i, uint32_t v)
+{
+    memcpy((unsigned char *)c->words + i * sizeof v, &v, sizeof v);
 }
 
 void vpdsi_cells_release(vpdsi_cells *c, vpdsi_mem *m)
@@ -73,6 +89,12 @@ void vpdsi_cells_push(vpdsi_cells *c, int dim, const uint64_t *coord)
 {
     uint64_t *w = c->words + c->count * c->words_per_cell;
     unsigned k;
+    if (c->words_per_cell == 0) {
+        uint32_t v = 0;
+        for (k = 0; k < (unsigned)dim; k++) v |= (uint32_t)(coord[k] << c->offset[k]);
+        half_set(c, c->count++, v);
+        return;
+    }
     memset(w, 0, c->words_per_cell * sizeof *w);
     for (k = 0; k < (unsigned)dim; k++) {
         unsigned off = c->offset[k], wi = off >> 6, sh = off & 63u;
@@ -84,7 +106,9 @@ void vpdsi_cells_push(vpdsi_cells *c, int dim, const uint64_t *coord)
 
 void vpdsi_cells_move(vpdsi_cells *c, size_t from, size_t to)
 {
-    if (from != to)
+    if (from != to && c->words_per_cell == 0)
+        half_set(c, to, half_get(c, from));
+    else if (from != to)
         memcpy(c->words + to * c->words_per_cell, c->words + from * c->words_per_cell,
                c->words_per_cell * sizeof *c->words);
 }
@@ -93,8 +117,8 @@ void vpdsi_cells_get(const vpdsi_cells *c, size_t i, int dim, uint64_t *coord)
 {
     const uint64_t *w = c->words + i * c->words_per_cell;
     unsigned k;
-    if (c->words_per_cell == 1) { /* the common case: every coordinate in one word */
-        uint64_t v = w[0];
+    if (c->words_per_cell <= 1) { /* the common case: every coordinate in one word */
+        uint64_t v = c->words_per_cell ? w[0] : half_get(c, i);
         for (k = 0; k < (unsigned)dim; k++)
             coord[k] = (v >> c->offset[k]) & ((UINT64_C(1) << c->bits[k]) - 1);
         return;

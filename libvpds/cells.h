@@ -1,15 +1,16 @@
 /* The flat hyper-octree of Algorithm 1: the active cells of one level, all the same size, stored
- * as integer coordinates bit-packed into 64-bit words (covered cells cost nothing). */
+ * as integer coordinates bit-packed into one 32-bit word per cell when they fit (a 2D lattice of
+ * 2^11 base cells per axis until level 5), else into 64-bit words (covered cells cost nothing). */
 #ifndef VPDS_CELLS_H
 #define VPDS_CELLS_H
 #include "mem.h"
 
 typedef struct vpdsi_cells {
-    uint64_t *words;
+    uint64_t *words;     /* read and written through memcpy: 32-bit cells share the words */
     size_t cap_words;
     size_t count;        /* cells held */
     unsigned level;
-    unsigned words_per_cell;
+    unsigned words_per_cell; /* 64-bit words per cell; 0: one 32-bit word per cell */
     unsigned bits[VPDS_MAX_DIM], offset[VPDS_MAX_DIM];
 } vpdsi_cells;
 

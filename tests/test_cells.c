@@ -1,0 +1,88 @@
+/* The active-cell array (cells.c) against a plain copy: in every dimension, for lattices whose
+ * cells fit one 32-bit word and for those that take one or more 64-bit words, the coordinates
+ * pushed are the coordinates read back, in order, after compaction by moves too; and a layout
+ * of at most 32 bits holds 4 bytes a cell. */
+#include "check.h"
+#include "vpds.h"
+#include "cells.h"
+#include <stdlib.h>
+#include <string.h>
+
+static unsigned long long rng_state = 777;
+static uint64_t next_u64(void)
+{
+    rng_state = rng_state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return rng_state ^ (rng_state >> 29);
+}
+
+/* Lattice n0 (per axis) at `level`: push n random cells, read them back, keep every third by
+ * moves, read again. */
+static void check_layout(int d, const uint64_t *n0, unsigned level, size_t n)
+{
+    vpdsi_mem mem;
+    vpdsi_cells c;
+    uint64_t *copy = (uint64_t *)malloc(n * (size_t)d * sizeof *copy), got[VPDS_MAX_DIM];
+    unsigned bits = 0;
+    size_t i, kept = 0;
+    int k, same = 1;
+    vpdsi_mem_init(&mem, NULL);
+    memset(&c, 0, sizeof c);
+    vpdsi_cells_layout(&c, d, n0, level);
+    for (k = 0; k < d; k++) bits += vpdsi_bit_length(n0[k]) + level;
+    CHECK(copy != NULL && vpdsi_cells_reserve(&c, &mem, n) == 0);
+    CHECK_MSG((bits <= 32) == (c.words_per_cell == 0), "%u bits, %u words per cell", bits,
+              c.words_per_cell);
+    if (bits <= 32) CHECK(c.cap_words * sizeof(uint64_t) < n * sizeof(uint32_t) + 64 * sizeof(uint64_t) + n * 2);
+    for (i = 0; i < n; i++) {
+        for (k = 0; k < d; k++) {
+            uint64_t span = n0[k] << level; /* every value below it, the largest most of all */
+            copy[i * d + k] = i % 3 == 0 ? span - 1 : next_u64() % span;
+        }
+        vpdsi_cells_push(&c, d, copy + i * d);
+    }
+    CHECK(c.count == n);
+    for (i = 0; i < n; i++) {
+        vpdsi_cells_get(&c, i, d, got);
+        same &= memcmp(got, copy + i * d, (size_t)d * sizeof *got) == 0;
+    }
+    for (i = 0; i < n; i += 3) { /* compaction in place, in order */
+        vpdsi_cells_move(&c, i, kept);
+        memmove(copy + kept * d, copy + i * d, (size_t)d * sizeof *copy);
+        kept++;
+    }
+    for (i = 0; i < kept; i++) {
+        vpdsi_cells_get(&c, i, d, got);
+        same &= memcmp(got, copy + i * d, (size_t)d * sizeof *got) == 0;
+    }
+    CHECK_MSG(same, "dim %d, level %u, %u bits: a cell read back differs", d, level, bits);
+    vpdsi_cells_release(&c, &mem);
+    free(copy);
+}
+
+int main(void)
+{
+    int d, rep;
+    unsigned level;
+    for (d = 1; d <= VPDS_MAX_DIM; d++)
+        for (rep = 0; rep < 6; rep++)
+            for (level = 0; level < 40; level += 1 + level / 4) {
+                uint64_t n0[VPDS_MAX_DIM];
+                unsigned total = 0;
+                int k;
+                for (k = 0; k < d; k++) {
+                    /* 1 to 2^(6 - rep) base cells, and sometimes many more */
+                    n0[k] = 1 + next_u64() % (rep == 5 ? 100000 : (UINT64_C(1) << (6 - rep)));
+                    total += vpdsi_bit_length(n0[k]) + level;
+                }
+                if (total > 60 * (unsigned)d) continue; /* past any run's lattice */
+                check_layout(d, n0, level, 1000);
+            }
+    /* the boundary: exactly 32 bits in one word, 33 in a 64-bit word */
+    {
+        uint64_t n16[2] = {UINT64_C(1) << 16, UINT64_C(1) << 16}, n17[2] = {UINT64_C(1) << 17, UINT64_C(1) << 16};
+        check_layout(2, n16, 0, 5000);
+        check_layout(2, n17, 0, 5000);
+        check_layout(2, n16, 1, 5000);
+    }
+    CHECK_DONE();
+}
