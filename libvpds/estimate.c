@@ -29,9 +29,24 @@ static double cells_per_base_cell(int d)
     return d <= 8 ? c[d] : c[8] * pow(2, d - 8);
 }
 
-/* Bytes per active cell (bit-packed coordinates and their sweep buffers) and per sample
- * (coordinates, r, t, flags, kd-tree and grid entries): fits of peak_bytes over 1D-11D runs. */
-#define BYTES_PER_CELL 16.0
+/* Bytes per active cell and per 64-bit word of its bit-packed coordinates (the level's cells
+ * and the next level's, with their growth), and per sample (coordinates, r, t, flags, kd-tree
+ * and grid entries): fits of peak_bytes over 1D-11D runs. A cell whose coordinates fit 32 bits
+ * takes half a word (cells.c). */
+#define BYTES_PER_CELL_WORD 16.0
+
+/* Bytes per active cell on the base grid of cells of side `side` over the box: its coordinates
+ * at level 2, where runs hold the most cells, in 32 bits or in 64-bit words. */
+static double bytes_per_cell(const vpdsi_problem *pb, double side)
+{
+    double bits = 0;
+    int k;
+    for (k = 0; k < pb->dim; k++) {
+        double n = ceil((pb->hi[k] - pb->lo[k]) / side);
+        bits += (n > 1 ? ceil(log2(n)) : 1) + 2;
+    }
+    return bits <= 32 ? BYTES_PER_CELL_WORD / 2 : BYTES_PER_CELL_WORD * ceil(bits / 64);
+}
 static double bytes_per_sample(int d)
 {
     static const double b[6] = {0, 32, 52, 131, 206, 311};
@@ -105,7 +120,7 @@ vpds_status vpdsi_estimate_run(const vpdsi_problem *pb, vpdsi_store *st, vpdsi_d
                    pow(pb->coverage / pb->inhibition, d / 5.0) * face_factor(pb, sums.inv_cell);
     out->base_cells = base;
     out->cells = cells_per_base_cell(d) * cells;
-    out->bytes = BYTES_PER_CELL * out->cells + bytes_per_sample(d) * out->samples;
+    out->bytes = bytes_per_cell(pb, side) * out->cells + bytes_per_sample(d) * out->samples;
     /* two radii keep the index of the uncovered region, a domain the cells along its boundary:
      * about as much again each, measured */
     if (pb->two_radii) out->bytes *= 2;
