@@ -112,6 +112,21 @@ static vpds_status check_memory_limit(vpds_sampler *s, double t)
     return VPDS_ERR_OUT_OF_MEMORY;
 }
 
+/* A first run with a constant radius and no domain: its count is known to about 1% before it
+ * runs (vpds_estimate, which then reads neither the sizing nor a domain), so the sample arrays
+ * are reserved for it at once instead of growing by half again (88 -> 70 B/sample at 10^6
+ * samples in 2D, with the 32-bit cells). Memory only: the same points. */
+static void expect_samples(vpds_sampler *s, double t)
+{
+    vpds_run_estimate e;
+    double n;
+    s->store.expect = 0;
+    if (s->store.n != 0 || s->store.sizing.kind != VPDSI_SIZING_CONSTANT || s->domain.fn) return;
+    if (vpdsi_estimate_run(&s->pb, &s->store, &s->domain, t, 0, &e) != VPDS_OK) return;
+    n = 1.02 * e.samples + 64;
+    if (n <= (double)VPDSI_STORE_EXPECT_MAX) s->store.expect = (size_t)n;
+}
+
 /* An allocation refused for the limit says so, after what the failing site said. */
 vpds_status vpdsi_sampler_note_limit(vpds_sampler *s, vpds_status st)
 {
@@ -133,6 +148,7 @@ vpds_status vpdsi_sampler_run(vpds_sampler *s)
     if ((st = ensure_rmax(s)) != VPDS_OK) return vpdsi_sampler_note_limit(s, st);
     if (s->mps.run.phase == VPDSI_IDLE && (st = check_memory_limit(s, s->mps.run.t)) != VPDS_OK)
         return st;
+    if (s->mps.run.phase == VPDSI_IDLE) expect_samples(s, s->mps.run.t);
     w.budget = s->budget;
     w.progress = s->progress;
     w.user = s->progress_user;

@@ -87,17 +87,19 @@ vpds_status vpdsi_store_radii(vpdsi_store *st, const double *x, size_t n, double
 
 vpds_status vpdsi_store_reserve(vpdsi_store *st, size_t more)
 {
-    size_t need = st->n + more, nx;
+    size_t need = st->n + more, want, nx;
     vpdsi_mem *m = st->mem;
     if (need < st->n || need > (size_t)INT32_MAX || vpdsi_mul_size(need, (size_t)st->dim, &nx)) {
         vpdsi_store_error(st, "%zu samples would overflow the sample index (at most %d)", need,
                           INT32_MAX);
         return VPDS_ERR_OVERFLOW;
     }
+    want = need <= st->expect ? st->expect : need; /* the expected count in one allocation */
+    if (want != need) nx = want * (size_t)st->dim; /* expect <= VPDSI_STORE_EXPECT_MAX */
     if (vpdsi_mem_reserve(m, (void **)&st->x, &st->cap_x, nx, sizeof(double)) ||
-        vpdsi_mem_reserve(m, (void **)&st->r, &st->cap_r, need, sizeof(double)) ||
-        vpdsi_mem_reserve(m, (void **)&st->t, &st->cap_t, need, sizeof(double)) ||
-        vpdsi_mem_reserve(m, (void **)&st->flags, &st->cap_flags, need, 1) ||
+        vpdsi_mem_reserve(m, (void **)&st->r, &st->cap_r, want, sizeof(double)) ||
+        vpdsi_mem_reserve(m, (void **)&st->t, &st->cap_t, want, sizeof(double)) ||
+        vpdsi_mem_reserve(m, (void **)&st->flags, &st->cap_flags, want, 1) ||
         (!st->grid_mode && !st->ogrid_mode &&
          vpdsi_kd_reserve(&st->tree, m, need, need - st->tree_n)) ||
         (st->ogrid_mode && vpdsi_ogrid_reserve(&st->ogrid, m, need, more))) {

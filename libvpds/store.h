@@ -16,6 +16,8 @@ typedef struct vpdsi_store {
     double period[VPDS_MAX_DIM];   /* box side on a periodic axis, 0 on an open one */
     vpdsi_sizing sizing;
     size_t n, n_fixed;
+    size_t expect;       /* the samples a run is expected to hold (0: unknown): a reserve below it
+                            takes it whole, so the arrays do not end up to half again too large */
     double *x; size_t cap_x;
     double *r; size_t cap_r;
     double *t; size_t cap_t;
@@ -28,6 +30,9 @@ typedef struct vpdsi_store {
     int ogrid_mode;
     char err[512];
 } vpdsi_store;
+
+/* The largest expected count a store reserves at once (16.7 million: 550 MB of samples in 2D). */
+#define VPDSI_STORE_EXPECT_MAX ((size_t)1 << 24)
 
 /* An empty store over the box [lo, hi] (period may be NULL: no periodic axis); the sizing is
  * filled by the caller. */
