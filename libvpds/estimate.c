@@ -41,12 +41,11 @@ static double bytes_per_cell(const vpdsi_problem *pb, double side)
 {
     double bits = 0;
     int k;
-    for (k = 0; k < pb->dim; k++) {
-        double n = ceil((pb->hi[k] - pb->lo[k]) / side);
-        bits += (n > 1 ? ceil(log2(n)) : 1) + 2;
-    }
+    for (k = 0; k < pb->dim; k++) /* cells.c's layout: the bits of n0, plus one per level */
+        bits += vpdsi_bit_length((uint64_t)ceil((pb->hi[k] - pb->lo[k]) / side)) + 2;
     return bits <= 32 ? BYTES_PER_CELL_WORD / 2 : BYTES_PER_CELL_WORD * ceil(bits / 64);
 }
+
 static double bytes_per_sample(int d)
 {
     static const double b[6] = {0, 32, 52, 131, 206, 311};

@@ -98,33 +98,29 @@ static vpds_status ensure_rmax(vpds_sampler *s)
                                       sizeof s->store.err);
 }
 
-/* A run about to start at scale t whose estimate exceeds the memory limit is refused. */
-static vpds_status check_memory_limit(vpds_sampler *s, double t)
+/* Before a run at scale t, one estimate (vpds_estimate) serves two ends: a run whose estimate
+ * exceeds the memory limit is refused; and a first run with a constant radius and no domain,
+ * whose count it gives to about 1% (reading neither the sizing nor a domain), has its sample
+ * arrays reserved at once instead of growing by half again (88 -> 64.5 B/sample at 10^6 samples
+ * in 2D, with the 32-bit cells; memory only: the same points). */
+static vpds_status plan_run(vpds_sampler *s, double t)
 {
     vpds_run_estimate e;
     vpds_status st;
-    if (s->mem.limit == 0) return VPDS_OK;
-    st = vpdsi_estimate_run(&s->pb, &s->store, &s->domain, t, sizeof *s, &e);
-    if (st != VPDS_OK || !(e.bytes > (double)s->mem.limit)) return st;
-    vpdsi_store_error(&s->store, "a maximal run at scale t = %g needs about %.3g bytes (%.3g samples,"
-                      " %.3g cells; vpds_estimate), above the memory limit of %zu bytes "
-                      "(vpds_set_memory_limit)", t, e.bytes, e.samples, e.cells, s->mem.limit);
-    return VPDS_ERR_OUT_OF_MEMORY;
-}
-
-/* A first run with a constant radius and no domain: its count is known to about 1% before it
- * runs (vpds_estimate, which then reads neither the sizing nor a domain), so the sample arrays
- * are reserved for it at once instead of growing by half again (88 -> 70 B/sample at 10^6
- * samples in 2D, with the 32-bit cells). Memory only: the same points. */
-static void expect_samples(vpds_sampler *s, double t)
-{
-    vpds_run_estimate e;
-    double n;
+    int expect = s->store.n == 0 && s->store.sizing.kind == VPDSI_SIZING_CONSTANT && !s->domain.fn;
     s->store.expect = 0;
-    if (s->store.n != 0 || s->store.sizing.kind != VPDSI_SIZING_CONSTANT || s->domain.fn) return;
-    if (vpdsi_estimate_run(&s->pb, &s->store, &s->domain, t, 0, &e) != VPDS_OK) return;
-    n = 1.02 * e.samples + 64;
-    if (n <= (double)VPDSI_STORE_EXPECT_MAX) s->store.expect = (size_t)n;
+    if (s->mem.limit == 0 && !expect) return VPDS_OK;
+    st = vpdsi_estimate_run(&s->pb, &s->store, &s->domain, t, sizeof *s, &e);
+    if (st != VPDS_OK) return s->mem.limit ? st : VPDS_OK;
+    if (s->mem.limit && e.bytes > (double)s->mem.limit) {
+        vpdsi_store_error(&s->store, "a maximal run at scale t = %g needs about %.3g bytes (%.3g samples,"
+                          " %.3g cells; vpds_estimate), above the memory limit of %zu bytes "
+                          "(vpds_set_memory_limit)", t, e.bytes, e.samples, e.cells, s->mem.limit);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    if (expect && 1.02 * e.samples + 64 <= (double)VPDSI_STORE_EXPECT_MAX)
+        s->store.expect = (size_t)(1.02 * e.samples + 64);
+    return VPDS_OK;
 }
 
 /* An allocation refused for the limit says so, after what the failing site said. */
@@ -146,9 +142,7 @@ vpds_status vpdsi_sampler_run(vpds_sampler *s)
     s->store.err[0] = 0;
     s->mem.limit_hit = 0;
     if ((st = ensure_rmax(s)) != VPDS_OK) return vpdsi_sampler_note_limit(s, st);
-    if (s->mps.run.phase == VPDSI_IDLE && (st = check_memory_limit(s, s->mps.run.t)) != VPDS_OK)
-        return st;
-    if (s->mps.run.phase == VPDSI_IDLE) expect_samples(s, s->mps.run.t);
+    if (s->mps.run.phase == VPDSI_IDLE && (st = plan_run(s, s->mps.run.t)) != VPDS_OK) return st;
     w.budget = s->budget;
     w.progress = s->progress;
     w.user = s->progress_user;
