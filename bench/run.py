@@ -10,6 +10,8 @@ beside its time: its smallest distance between two points against the minimum di
 and the share of random probes with room for another point (farther than that distance from
 every point: 0 for a maximal set). The floor is drawing the same number of uniform random points
 with libvpds's own generator. Times are wall-clock seconds of one run on this machine, one core.
+Memory beside a peer is each process's peak resident memory per sample (os.wait4's rusage), the
+bench program's for libvpds.
 """
 from __future__ import annotations
 
@@ -57,9 +59,29 @@ def install_peers() -> dict[str, object]:
     return peers
 
 
+def sh_rss(cmd: list[str]) -> tuple[str, int]:
+    """sh, and the command's own peak resident memory in bytes (its rusage, from os.wait4)."""
+    with open(OUT / "stderr.txt", "w") as err:
+        p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=err, text=True)
+        assert p.stdout is not None
+        out = p.stdout.read()
+        _, status, usage = os.wait4(p.pid, 0)
+        p.returncode = os.waitstatus_to_exitcode(status)
+    if p.returncode:
+        raise subprocess.CalledProcessError(p.returncode, cmd, out)
+    return out, usage.ru_maxrss * 1024
+
+
 def vpds(*args) -> tuple[int, float, int]:
     out = sh([str(OUT / "bench"), *map(str, args)]).split()
     return int(out[1]), float(out[2]), int(out[3])
+
+
+def vpds_rss(*args) -> tuple[int, float, int, int]:
+    """vpds, and the bench process's peak resident memory: what a peer's is compared with."""
+    text, rss = sh_rss([str(OUT / "bench"), *map(str, args)])
+    out = text.split()
+    return int(out[1]), float(out[2]), int(out[3]), rss
 
 
 PROBES = 200_000
@@ -85,14 +107,23 @@ def output_quality(points, r: float, dim: int) -> str:
                f" ({100 * upper:.0f}% of those within r of an upper face)"))
 
 
-def peer_points(cmd: list[str], dim: int) -> tuple[int, float, object]:
-    """Runs a peer that writes its points to the file named last: (n, seconds, points)."""
+def peer_points(cmd: list[str], dim: int) -> tuple[int, float, object, int]:
+    """Runs a peer that writes its points to the file named last: (n, seconds, points, its peak
+    resident memory in bytes)."""
     import numpy as np
     path = OUT / "peer_points.txt"
-    out = sh([*cmd, str(path)]).split()
+    text, rss = sh_rss([*cmd, str(path)])
+    out = text.split()
     pts = np.loadtxt(path, ndmin=2).reshape(-1, dim)
     path.unlink()
-    return int(out[0]), float(out[1]), pts
+    return int(out[0]), float(out[1]), pts, rss
+
+
+def versus(n: int, sec: float, rss: int, pn: int, ps: float, prss: int) -> str:
+    """libvpds against a peer on the same workload: samples per second and peak resident bytes
+    per sample (whole processes), as ratios."""
+    return (f"libvpds/peer samples-per-second: {(n / sec) / (pn / ps):.2f}; peak RSS per sample "
+            f"{rss / n:.0f} B against {prss / pn:.0f} B: {(rss / n) / (prss / pn):.2f}")
 
 
 def vpds_points(dim: int, r: float):
@@ -120,26 +151,23 @@ def main() -> None:
     # 2D uniform, about a million samples (fewer with --quick)
     n_target = 1e5 if QUICK else 1e6
     r = radius_for(n_target, 2)
-    n, sec, mem = vpds("uniform", 2, r)
-    row(f"libvpds 2D uniform r={r:.6f} (maximal)", n, sec, mem)
+    n, sec, mem, rss = vpds_rss("uniform", 2, r)
+    row(f"libvpds 2D uniform r={r:.6f} (maximal)", n, sec, mem, note=f"peak RSS {rss / n:.0f} B/sample")
     base_rate = n / sec
     fn, fsec, _ = vpds("floor", n, 2)
     row("floor: same count of uniform points", fn, fsec, note=f"libvpds is {sec / fsec:.0f}x the floor")
     print(output_quality(vpds_points(2, r), r, 2), flush=True)
     if "npm" in peers:
-        pn, ps, pts = peer_points(["node", str(peers["npm"]), repr(r), "1"], 2)
-        row("npm poisson-disk-sampling (not maximal)", pn, ps,
-            note=f"libvpds/peer samples-per-second: {base_rate / (pn / ps):.2f}")
+        pn, ps, pts, prss = peer_points(["node", str(peers["npm"]), repr(r), "1"], 2)
+        row("npm poisson-disk-sampling (not maximal)", pn, ps, note=versus(n, sec, rss, pn, ps, prss))
         print(output_quality(pts, r, 2), flush=True)
     if "rust" in peers:
-        pn, ps, pts = peer_points([str(peers["rust"]), "2", repr(r), "1"], 2)
-        row("crate fast_poisson (not maximal)", pn, ps,
-            note=f"libvpds/peer samples-per-second: {base_rate / (pn / ps):.2f}")
+        pn, ps, pts, prss = peer_points([str(peers["rust"]), "2", repr(r), "1"], 2)
+        row("crate fast_poisson (not maximal)", pn, ps, note=versus(n, sec, rss, pn, ps, prss))
         print(output_quality(pts, r, 2), flush=True)
     if "ebeida" in peers:  # its radius is half the minimum distance: the binary passes r / 2
-        pn, ps, pts = peer_points([str(peers["ebeida"]), "2", repr(r), "1"], 2)
-        row("crate poisson 0.10.1, Ebeida mode", pn, ps,
-            note=f"libvpds/peer samples-per-second: {base_rate / (pn / ps):.2f}")
+        pn, ps, pts, prss = peer_points([str(peers["ebeida"]), "2", repr(r), "1"], 2)
+        row("crate poisson 0.10.1, Ebeida mode", pn, ps, note=versus(n, sec, rss, pn, ps, prss))
         print(output_quality(pts, r, 2), flush=True)
     if "scipy" in peers:
         # scipy is too slow for a million: compare on a smaller workload, both sides
@@ -173,19 +201,19 @@ def main() -> None:
     n, sec, mem = vpds("uniform", 3, radius_for(1e5 if QUICK else 1e6, 3))
     row("libvpds 3D uniform", n, sec, mem)
     if "rust" in peers and not QUICK:
-        out = sh([str(peers["rust"]), "3", repr(radius_for(1e5, 3)), "1"]).split()
-        vn, vs, _ = vpds("uniform", 3, radius_for(1e5, 3))
+        text, prss = sh_rss([str(peers["rust"]), "3", repr(radius_for(1e5, 3)), "1"])
+        out = text.split()
+        vn, vs, _, vrss = vpds_rss("uniform", 3, radius_for(1e5, 3))
         row("libvpds 3D uniform (1e5)", vn, vs)
         row("crate fast_poisson 3D (1e5)", int(out[0]), float(out[1]),
-            note=f"libvpds/peer samples-per-second: {(vn / vs) / (int(out[0]) / float(out[1])):.2f}")
+            note=versus(vn, vs, vrss, int(out[0]), float(out[1]), prss))
     if "ebeida" in peers:  # about 1,000 samples/s in 3D: 1e4 samples (3e3 with --quick)
         r3 = radius_for(3e3 if QUICK else 1e4, 3)
-        vn, vs, _ = vpds("uniform", 3, r3)
+        vn, vs, _, vrss = vpds_rss("uniform", 3, r3)
         row(f"libvpds 3D uniform r={r3:.4f}", vn, vs)
         print(output_quality(vpds_points(3, r3), r3, 3), flush=True)
-        pn, ps, pts = peer_points([str(peers["ebeida"]), "3", repr(r3), "1"], 3)
-        row("crate poisson 0.10.1 3D, Ebeida mode", pn, ps,
-            note=f"libvpds/peer samples-per-second: {(vn / vs) / (pn / ps):.2f}")
+        pn, ps, pts, prss = peer_points([str(peers["ebeida"]), "3", repr(r3), "1"], 3)
+        row("crate poisson 0.10.1 3D, Ebeida mode", pn, ps, note=versus(vn, vs, vrss, pn, ps, prss))
         print(output_quality(pts, r3, 3), flush=True)
     # 4D (the high-dimension issue's yardstick: r = 0.06, about 7.5e4 samples; 0.1 with --quick)
     r4 = 0.1 if QUICK else 0.06
