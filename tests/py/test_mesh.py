@@ -32,19 +32,22 @@ def square(n=6, jitter=0.3, seed=0):
     return v, np.array(f)
 
 
+# barycentrics of a triangle's corners and edge midpoints, probed on every triangle
+CORNERS_AND_MIDPOINTS = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [.5, .5, 0], [0, .5, .5], [.5, 0, .5]])
+
+
 def probes(v, f, per_unit_area, rng):
     """Corners, edge midpoints and area-uniform random points of every triangle: the points,
     their triangles and barycentrics."""
     a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
     area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
-    fixed = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [.5, .5, 0], [0, .5, .5], [.5, 0, .5]])
     faces, bary = [], []
     for k in range(len(f)):
         m = max(3, int(area[k] * per_unit_area))
         s, t = rng.random(m), rng.random(m)
         flip = s + t > 1
         s[flip], t[flip] = 1 - s[flip], 1 - t[flip]
-        bk = np.concatenate([fixed, np.column_stack([1 - s - t, s, t])])
+        bk = np.concatenate([CORNERS_AND_MIDPOINTS, np.column_stack([1 - s - t, s, t])])
         faces.append(np.full(len(bk), k))
         bary.append(bk)
     faces, bary = np.concatenate(faces), np.concatenate(bary)
@@ -179,8 +182,7 @@ def face_probes(v, f, rng, per_face=3):
     s, t = rng.random((len(f), per_face)), rng.random((len(f), per_face))
     flip = s + t > 1
     s[flip], t[flip] = 1 - s[flip], 1 - t[flip]
-    fixed = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [.5, .5, 0], [0, .5, .5], [.5, 0, .5]])
-    bary = np.concatenate([np.broadcast_to(fixed, (len(f), 6, 3)),
+    bary = np.concatenate([np.broadcast_to(CORNERS_AND_MIDPOINTS, (len(f), 6, 3)),
                            np.stack([1 - s - t, s, t], -1)], axis=1)
     return np.einsum("fpk,fkd->fpd", bary, v[f]).reshape(-1, 3)
 
