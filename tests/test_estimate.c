@@ -7,6 +7,7 @@
 #include <string.h>
 
 static double ramp(const double *x, void *u) { (void)u; return 0.002 + 0.2 * x[0]; }
+static double wide_ramp(const double *x, void *u) { (void)u; return 3 + 0.2 * x[0]; }
 static double bad_sizing(const double *x, void *u) { (void)u; return x[0] > 0.5 ? NAN : 0.05; }
 static double disk(const double *x, void *u)
 {
@@ -172,6 +173,42 @@ static void check_too_large(void)
     vpds_destroy(s);
 }
 
+/* The allocator of check_rmax_memory: malloc, noting the largest single request. */
+static void *largest_alloc(size_t size, void *user)
+{
+    size_t *largest = (size_t *)user;
+    if (size > *largest) *largest = size;
+    return malloc(size);
+}
+static void largest_free(void *p, size_t size, void *user)
+{
+    (void)size;
+    (void)user;
+    free(p);
+}
+
+/* r_max of a sizing is read on a lattice of 3^d points from 7 dimensions on (531,441 in 12D,
+ * 43 million in 16D); it is read in chunks, so the memory for it does not grow with 3^d (it was
+ * one 55 MB block in 12D and 5.8 GB in 16D: the fuzzers' out-of-memory). */
+static void check_rmax_memory(void)
+{
+    vpds_desc d = uniform(12, 3);
+    vpds_sampler *s = NULL;
+    vpds_run_estimate e;
+    size_t largest = 0;
+    d.sizing = wide_ramp;
+    d.lipschitz = 0.2;
+    d.allocator.alloc = largest_alloc;
+    d.allocator.free = largest_free;
+    d.allocator.user = &largest;
+    CHECK(vpds_create(&d, &s) == VPDS_OK);
+    CHECK_MSG(vpds_estimate(s, 0, &e) == VPDS_OK, "%s", vpds_last_error(s));
+    CHECK_MSG(largest < 1024 * 1024, "12D sizing: a single allocation of %zu bytes", largest);
+    CHECK(vpds_set_budget(s, 200) == VPDS_OK);
+    CHECK_MSG(vpds_run(s) == VPDS_PAUSED && vpds_count(s) > 0, "%s", vpds_last_error(s));
+    vpds_destroy(s);
+}
+
 int main(void)
 {
     static const double radius[7] = {0, 0.0005, 0.01, 0.04, 0.15, 0.4, 0.6};
@@ -201,5 +238,6 @@ int main(void)
     check_bad_arguments();
     check_memory_limit();
     check_too_large();
+    check_rmax_memory();
     CHECK_DONE();
 }
