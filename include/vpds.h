@@ -54,8 +54,11 @@ extern "C" {
  * version 4). 6: with two radii each cell a dart asks about keeps which of its sub-boxes its
  * searches showed covered, later questions and the sweep skip them, and a search visits a box's
  * children from the one farthest from the dart (other points with two radii, where the search's
- * box budget decided). */
-#define VPDS_ALGORITHM_VERSION 6
+ * box budget decided). 7: the stream on a mesh (vpds_mesh_next) splits a piece in two at its
+ * longest edge instead of in four at its edges' midpoints, so that a needle's pieces get shorter
+ * without getting thinner (other points for vpds_mesh_next; the runs and every box give the
+ * points of version 6). */
+#define VPDS_ALGORITHM_VERSION 7
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 16
 /* Relative tolerance eps of the continuous stream (vpds_next): each t it reports is an upper

@@ -71,7 +71,7 @@ vpds_status vpdsi_trimesh_radius(const vpdsi_trimesh *mesh, vpdsi_store *st, uin
     return vpdsi_store_radius_at(st, x, r);
 }
 
-vpds_status vpdsi_piece_bounds(const vpdsi_trimesh *mesh, vpdsi_store *st, const vpdsi_piece *p,
+vpds_status vpdsi_piece_bounds(const vpdsi_trimesh *mesh, vpdsi_store *st, uint32_t tri,
                                double uv[3][2], double x[3][3], double *r_lo, double *r_hi)
 {
     double r, c[3], cuv[2], h2 = 0;
@@ -81,7 +81,7 @@ vpds_status vpdsi_piece_bounds(const vpdsi_trimesh *mesh, vpdsi_store *st, const
         *r_lo = INFINITY;
         *r_hi = 0;
         for (q = 0; q < 3; q++) {
-            if ((e = vpdsi_trimesh_radius(mesh, st, p->tri, uv[q], x[q], &r)) != VPDS_OK) return e;
+            if ((e = vpdsi_trimesh_radius(mesh, st, tri, uv[q], x[q], &r)) != VPDS_OK) return e;
             if (r < *r_lo) *r_lo = r;
             if (r > *r_hi) *r_hi = r;
         }
@@ -99,7 +99,7 @@ vpds_status vpdsi_piece_bounds(const vpdsi_trimesh *mesh, vpdsi_store *st, const
         for (k = 0; k < 3; k++) d2 += (x[q][k] - c[k]) * (x[q][k] - c[k]);
         if (d2 > h2) h2 = d2;
     }
-    if ((e = vpdsi_trimesh_radius(mesh, st, p->tri, cuv, c, &r)) != VPDS_OK) return e;
+    if ((e = vpdsi_trimesh_radius(mesh, st, tri, cuv, c, &r)) != VPDS_OK) return e;
     *r_lo = r - st->sizing.lipschitz * sqrt(h2) * (1 + 1e-12);
     *r_hi = r + st->sizing.lipschitz * sqrt(h2) * (1 + 1e-12);
     if (*r_lo < 0) *r_lo = 0;

@@ -387,7 +387,7 @@ static vpds_status sweep_one_piece(vpdsi_surface *s, const vpdsi_surface_ctx *ct
     vpds_status e;
     int q;
     vpdsi_piece_corners(ctx->mesh, s->seed_m[p->tri], p, uv, x);
-    if ((e = vpdsi_piece_bounds(ctx->mesh, ctx->st, p, uv, x, &r_lo, &r_hi)) != VPDS_OK) return e;
+    if ((e = vpdsi_piece_bounds(ctx->mesh, ctx->st, p->tri, uv, x, &r_lo, &r_hi)) != VPDS_OK) return e;
     if (s->last_cover >= 0 && holds_corners(s, ctx, s->last_cover, x, r_lo)) return VPDS_OK;
     if ((e = piece_near(s, ctx, x, r_hi, vpdsi_piece_edge(ctx->mesh, s->seed_m[p->tri], p))) != VPDS_OK)
         return e;
@@ -403,7 +403,7 @@ static vpds_status sweep_one_piece(vpdsi_surface *s, const vpdsi_surface_ctx *ct
         vpdsi_piece_corners(ctx->mesh, s->seed_m[c.tri], &c, cuv, cx);
         /* a child lies in its parent: the parent's bounds hold, vertex radii's exact ones are
          * tighter */
-        if (ctx->mesh->vr && (e = vpdsi_piece_bounds(ctx->mesh, ctx->st, &c, cuv, cx, &c_lo, &c_hi)) != VPDS_OK)
+        if (ctx->mesh->vr && (e = vpdsi_piece_bounds(ctx->mesh, ctx->st, c.tri, cuv, cx, &c_lo, &c_hi)) != VPDS_OK)
             return e;
         if (!corners_covered(s, ctx, cx, c_lo)) s->next[s->n_next++] = c;
         if (c.level + 1u > ctx->stats->levels) ctx->stats->levels = c.level + 1u;

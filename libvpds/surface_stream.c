@@ -7,6 +7,12 @@
 
 #define STREAM_MAX_LEVEL 52 /* lattice coordinates below 2^52 stay exact */
 
+void vpdsi_surface_stream_init(vpdsi_surface_stream *ss, uint32_t algorithm_version)
+{
+    memset(ss, 0, sizeof *ss);
+    ss->bisect = algorithm_version >= 7;
+}
+
 void vpdsi_surface_stream_release(vpdsi_surface_stream *ss, vpdsi_mem *m)
 {
     vpdsi_mem_free(m, ss->heap, ss->cap_heap * sizeof *ss->heap);
@@ -41,15 +47,16 @@ static void heap_sift_down(vpdsi_surface_heap_entry *h, size_t n, size_t i)
     }
 }
 
-/* The piece's centroid (parameters cuv, position c) and its farthest corner's distance. */
-static double piece_centre(const vpdsi_trimesh *mesh, const vpdsi_piece *p, double uv[3][2],
+/* The piece's corners (positions x), centroid (parameters cuv, position c) and its farthest
+ * corner's distance. */
+static double piece_centre(const vpdsi_trimesh *mesh, const vpdsi_surface_heap_entry *p,
                            double x[3][3], double *cuv, double *c)
 {
     double h2 = 0;
     int q, k;
-    vpdsi_piece_corners(mesh, 1, p, uv, x);
-    cuv[0] = (uv[0][0] + uv[1][0] + uv[2][0]) / 3;
-    cuv[1] = (uv[0][1] + uv[1][1] + uv[2][1]) / 3;
+    for (q = 0; q < 3; q++) vpdsi_trimesh_point(mesh, p->tri, p->uv[q], x[q]);
+    cuv[0] = (p->uv[0][0] + p->uv[1][0] + p->uv[2][0]) / 3;
+    cuv[1] = (p->uv[0][1] + p->uv[1][1] + p->uv[2][1]) / 3;
     vpdsi_trimesh_point(mesh, p->tri, cuv, c);
     for (q = 0; q < 3; q++) {
         double d2 = 0;
@@ -61,13 +68,15 @@ static double piece_centre(const vpdsi_trimesh *mesh, const vpdsi_piece *p, doub
 
 /* An upper bound of g over the piece: for y in it |y - x_i| <= |c - x_i| + h and
  * f(r(x_i), r(y)) >= f(r(x_i), r_lo), f being non-decreasing (vpdsi_kd_min_ratio's slack form). */
-static vpds_status piece_upper_bound(const vpdsi_surface_ctx *ctx, const vpdsi_piece *p, double *ub)
+static vpds_status piece_upper_bound(const vpdsi_surface_ctx *ctx, const vpdsi_surface_heap_entry *p,
+                                     double *ub)
 {
     vpdsi_kd_samples v = vpdsi_store_view(ctx->st);
-    double uv[3][2], x[3][3], cuv[2], c[3], r_lo, r_hi, h = piece_centre(ctx->mesh, p, uv, x, cuv, c);
+    double uv[3][2], x[3][3], cuv[2], c[3], r_lo, r_hi, h = piece_centre(ctx->mesh, p, x, cuv, c);
     int32_t arg;
-    vpds_status e = vpdsi_piece_bounds(ctx->mesh, ctx->st, p, uv, x, &r_lo, &r_hi);
-    if (e != VPDS_OK) return e;
+    vpds_status e;
+    memcpy(uv, p->uv, sizeof uv);
+    if ((e = vpdsi_piece_bounds(ctx->mesh, ctx->st, p->tri, uv, x, &r_lo, &r_hi)) != VPDS_OK) return e;
     *ub = vpdsi_kd_min_ratio(&ctx->st->tree, &v, c, h, r_lo, (int)ctx->rule, &arg);
     return VPDS_OK;
 }
@@ -88,9 +97,11 @@ static void start_heap(vpdsi_surface_stream *ss, const vpdsi_trimesh *mesh)
 {
     size_t k;
     for (k = 0; k < mesh->n_live; k++) {
-        memset(&ss->heap[k], 0, sizeof ss->heap[k]);
-        ss->heap[k].p.tri = (uint32_t)k;
-        ss->heap[k].ub = INFINITY;
+        vpdsi_surface_heap_entry *p = &ss->heap[k];
+        memset(p, 0, sizeof *p);
+        p->uv[1][0] = p->uv[2][1] = 1; /* corners (0, 0), (1, 0), (0, 1) */
+        p->tri = (uint32_t)k;
+        p->ub = INFINITY;
     }
     ss->n_heap = mesh->n_live;
     ss->started = 1;
@@ -138,14 +149,14 @@ static vpds_status first_surface_sample(vpdsi_surface_stream *ss, const vpdsi_su
 
 /* g at the piece's centroid (r there exact); a better point than *best replaces it. With a sizing
  * callback the bounds trust the declared L: it is checked against the nearest sample. */
-static vpds_status look_at_centre(const vpdsi_surface_ctx *ctx, const vpdsi_piece *p,
+static vpds_status look_at_centre(const vpdsi_surface_ctx *ctx, const vpdsi_surface_heap_entry *p,
                                   vpdsi_surface_best *best)
 {
     vpdsi_kd_samples v = vpdsi_store_view(ctx->st);
-    double uv[3][2], x[3][3], cuv[2], c[3], r, g;
+    double x[3][3], cuv[2], c[3], r, g;
     int32_t arg;
     vpds_status e;
-    piece_centre(ctx->mesh, p, uv, x, cuv, c);
+    piece_centre(ctx->mesh, p, x, cuv, c);
     if ((e = vpdsi_trimesh_radius(ctx->mesh, ctx->st, p->tri, cuv, c, &r)) != VPDS_OK) return e;
     g = vpdsi_kd_min_ratio(&ctx->st->tree, &v, c, 0, r, (int)ctx->rule, &arg);
     if (!ctx->mesh->vr && ctx->st->sizing.kind != VPDSI_SIZING_CONSTANT && arg >= 0) {
@@ -165,44 +176,126 @@ static vpds_status look_at_centre(const vpdsi_surface_ctx *ctx, const vpdsi_piec
     return VPDS_OK;
 }
 
-/* Split the top piece (bound ub) into its four children, each with its own bound and its centre
+static void midpoint(const double *a, const double *b, double *m)
+{
+    m[0] = (a[0] + b[0]) / 2;
+    m[1] = (a[1] + b[1]) / 2;
+}
+
+static void set_corners(vpdsi_surface_heap_entry *p, const double *a, const double *b, const double *c)
+{
+    memcpy(p->uv[0], a, 2 * sizeof *a);
+    memcpy(p->uv[1], b, 2 * sizeof *b);
+    memcpy(p->uv[2], c, 2 * sizeof *c);
+}
+
+/* The four children of the midpoint split, in the order and corner order of vpdsi_piece_child
+ * (versions 3-6 give the same points). */
+static int split_four(const vpdsi_surface_heap_entry *p, vpdsi_surface_heap_entry *child)
+{
+    double m01[2], m02[2], m12[2];
+    int q;
+    midpoint(p->uv[0], p->uv[1], m01);
+    midpoint(p->uv[0], p->uv[2], m02);
+    midpoint(p->uv[1], p->uv[2], m12);
+    for (q = 0; q < 4; q++) child[q] = *p;
+    set_corners(&child[0], p->uv[0], m01, m02);
+    set_corners(&child[1], m01, p->uv[1], m12);
+    set_corners(&child[2], m02, m12, p->uv[2]);
+    set_corners(&child[3], m01, m02, m12);
+    return 4;
+}
+
+/* The longest edge of a piece (in space, not in parameters): its first corner into *first. */
+static double longest_edge(const vpdsi_trimesh *mesh, const vpdsi_surface_heap_entry *p, int *first)
+{
+    double x[3][3], best = -1;
+    int q, k;
+    for (q = 0; q < 3; q++) vpdsi_trimesh_point(mesh, p->tri, p->uv[q], x[q]);
+    for (q = 0; q < 3; q++) {
+        const double *a = x[q], *b = x[(q + 1) % 3];
+        double d2 = 0;
+        for (k = 0; k < 3; k++) d2 += (a[k] - b[k]) * (a[k] - b[k]);
+        if (d2 > best) {
+            best = d2;
+            *first = q;
+        }
+    }
+    return sqrt(best);
+}
+
+/* The two halves at the midpoint of the longest edge: a needle is cut across until its pieces
+ * are as wide as long, and only then along (the four-way split halves its width each time). */
+static int split_two(const vpdsi_trimesh *mesh, const vpdsi_surface_heap_entry *p,
+                     vpdsi_surface_heap_entry *child)
+{
+    double m[2];
+    int a, b, c;
+    longest_edge(mesh, p, &a);
+    b = (a + 1) % 3;
+    c = (a + 2) % 3;
+    midpoint(p->uv[a], p->uv[b], m);
+    child[0] = child[1] = *p;
+    set_corners(&child[0], p->uv[a], m, p->uv[c]);
+    set_corners(&child[1], m, p->uv[b], p->uv[c]);
+    return 2;
+}
+
+/* Split the top piece (bound ub) into its children, each with its own bound and its centre
  * looked at; nothing changes on failure. */
 static vpds_status split_top(vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ctx, double ub,
                              vpdsi_surface_best *best)
 {
-    vpdsi_piece p = ss->heap[0].p, child[4];
-    double cub[4];
+    vpdsi_surface_heap_entry p = ss->heap[0], child[4];
     vpdsi_surface_best keep = *best;
-    int q;
+    int q, n;
     vpds_status e;
     if (vpdsi_mem_reserve(ctx->st->mem, (void **)&ss->heap, &ss->cap_heap, ss->n_heap + 3, sizeof *ss->heap)) {
         vpdsi_store_error(ctx->st, "out of memory for the stream's %zu pieces", ss->n_heap + 3);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
-    for (q = 0; q < 4; q++) {
-        child[q] = vpdsi_piece_child(&p, q);
-        if ((e = piece_upper_bound(ctx, &child[q], &cub[q])) != VPDS_OK ||
+    n = ss->bisect ? split_two(ctx->mesh, &p, child) : split_four(&p, child);
+    for (q = 0; q < n; q++) {
+        child[q].level = p.level + 1;
+        if ((e = piece_upper_bound(ctx, &child[q], &child[q].ub)) != VPDS_OK ||
             (e = look_at_centre(ctx, &child[q], best)) != VPDS_OK) {
             *best = keep;
             return e;
         }
-        if (cub[q] > ub) cub[q] = ub; /* the child lies in its parent */
+        if (child[q].ub > ub) child[q].ub = ub; /* the child lies in its parent */
     }
-    ss->heap[0].p = child[0];
-    ss->heap[0].ub = cub[0];
+    ss->heap[0] = child[0];
     heap_sift_down(ss->heap, ss->n_heap, 0);
-    for (q = 1; q < 4; q++) {
-        ss->heap[ss->n_heap].p = child[q];
-        ss->heap[ss->n_heap].ub = cub[q];
+    for (q = 1; q < n; q++) {
+        ss->heap[ss->n_heap] = child[q];
         heap_sift_up(ss->heap, ss->n_heap++);
     }
     if (p.level + 1u > ctx->stats->levels) ctx->stats->levels = p.level + 1u;
     return VPDS_OK;
 }
 
-static int may_split(const vpdsi_surface_ctx *ctx, const vpdsi_piece *p)
+/* a + b without rounding (the error of the sum, Knuth's TwoSum, is zero): then (a + b) / 2 is
+ * exact and two children tile their parent exactly */
+static int exact_sum(double a, double b)
 {
-    return p->level < STREAM_MAX_LEVEL && vpdsi_piece_edge(ctx->mesh, 1, p) >= 2 * ctx->mesh->min_edge;
+    double s = a + b, bb = s - a;
+    return (a - (s - bb)) + (b - bb) == 0;
+}
+
+/* Pieces stop splitting where their corners would lose exactness or they reach the mesh's
+ * smallest edge (52 four-way splits keep lattice coordinates below 2^52). */
+static int may_split(const vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ctx,
+                     const vpdsi_surface_heap_entry *p)
+{
+    if (ss->bisect) {
+        int a, b;
+        if (p->level >= 4 * STREAM_MAX_LEVEL || longest_edge(ctx->mesh, p, &a) < 2 * ctx->mesh->min_edge)
+            return 0;
+        b = (a + 1) % 3;
+        return exact_sum(p->uv[a][0], p->uv[b][0]) && exact_sum(p->uv[a][1], p->uv[b][1]);
+    }
+    return p->level < STREAM_MAX_LEVEL &&
+           ldexp(ctx->mesh->longest[p->tri], -(int)p->level) >= 2 * ctx->mesh->min_edge;
 }
 
 vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ctx,
@@ -220,7 +313,7 @@ vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx
     }
     for (;;) {
         double ub, t;
-        if ((e = piece_upper_bound(ctx, &ss->heap[0].p, &ub)) != VPDS_OK) return e;
+        if ((e = piece_upper_bound(ctx, &ss->heap[0], &ub)) != VPDS_OK) return e;
         if (ub < ss->heap[0].ub) {
             /* a sample came nearer since the bound was taken: it falls back in the heap */
             ss->heap[0].ub = ub;
@@ -231,8 +324,8 @@ vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx
         t = ub / ctx->coverage < t_max ? ub / ctx->coverage : t_max;
         if (!(t > t_min)) return VPDS_STREAM_END;
         /* ub bounds g over the whole surface: a point within the tolerance of it is the next */
-        if ((e = look_at_centre(ctx, &ss->heap[0].p, best)) != VPDS_OK) return e;
-        if (best->g >= ub * (1 - VPDS_STREAM_TOLERANCE) || !may_split(ctx, &ss->heap[0].p)) {
+        if ((e = look_at_centre(ctx, &ss->heap[0], best)) != VPDS_OK) return e;
+        if (best->g >= ub * (1 - VPDS_STREAM_TOLERANCE) || !may_split(ss, ctx, &ss->heap[0])) {
             if ((e = vpdsi_marks_reserve(ctx->marks, ctx->st, 1)) != VPDS_OK) return e;
             vpdsi_marks_append(ctx->marks, ctx->st, ctx->mesh, best->tri, best->uv, best->x, best->r, t);
             ctx->stats->accepted++;

@@ -1166,6 +1166,54 @@ static void test_lone_sliver(void)
     mesh_free(&m);
 }
 
+/* Peak bytes of `events` stream events on m (constant radius, rule smaller) at a version. */
+static size_t stream_peak(const mesh_t *m, double radius, uint32_t version, int events)
+{
+    vpds_mesh_desc d = desc_for(m);
+    vpds_mesh *s = NULL;
+    double x[3], t;
+    size_t peak;
+    int k;
+    d.radius = radius;
+    d.algorithm_version = version;
+    if (vpds_mesh_create(&d, &s) != VPDS_OK) { CHECK(0); return 0; }
+    for (k = 0; k < events; k++) CHECK(vpds_mesh_next(s, 0, x, &t) == VPDS_OK);
+    peak = vpds_mesh_get_stats(s).peak_bytes;
+    vpds_mesh_destroy(s);
+    return peak;
+}
+
+/* Needles among ordinary triangles (the fuzzers' stream-slivers): from version 7 the stream
+ * splits a piece at its longest edge, so a needle's pieces get shorter without getting thinner;
+ * version 6's four-way split halved the width too, 2^level pieces across the needle with the
+ * same bound. The stream's promises hold, and its pieces take far less memory. */
+static void test_stream_needles(void)
+{
+    mesh_t m = {0};
+    size_t p6, p7;
+    add_v(&m, 0, 0, 0);
+    add_v(&m, 1, 0, 0);
+    add_v(&m, 1, 2e-4, 0);
+    add_v(&m, 0, 0.6, 0.1);
+    add_v(&m, -0.5, 0.1, 0.2);
+    add_v(&m, 0.2, -0.5, 0);
+    add_v(&m, -0.3, -0.4, 0.5);
+    add_v(&m, -0.3 + 1e-5, -0.4, 0.5);
+    add_t(&m, 0, 1, 2);
+    add_t(&m, 0, 2, 3);
+    add_t(&m, 0, 3, 4);
+    add_t(&m, 0, 5, 1);
+    add_t(&m, 0, 6, 7);
+    stream_case("stream, needles", &m, NULL, r_const, VPDS_RULE_SMALLER, 0.03, quick ? 60 : 150);
+    if (!quick) { /* version 6 takes 77 MB here: not under valgrind */
+        p6 = stream_peak(&m, 0.03, 6, 25);
+        p7 = stream_peak(&m, 0.03, 7, 25);
+        CHECK_MSG(p7 > 0 && 10 * p7 < p6, "needles: stream peak %zu bytes (version 7) against %zu (version 6)",
+                  p7, p6);
+    }
+    mesh_free(&m);
+}
+
 /* Triangles at the ends of the coordinate range are sampled, not refused: edges of 1e80 and of
  * 1e-160 (their squared cross products would overflow or underflow unscaled). */
 static void test_extreme_sizes(void)
@@ -1222,6 +1270,7 @@ int main(void)
     test_bias();
     test_stream();
     test_stream_mixing();
+    test_stream_needles();
     test_wide_extent();
     test_lone_sliver();
     test_refine_refused();

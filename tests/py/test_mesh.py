@@ -165,6 +165,25 @@ def test_exactly_n_points_from_the_stream():
         vpds.sample_mesh(m, n=10, t=0.5)
 
 
+def test_algorithm_version_pins_the_mesh_stream():
+    """Version 7 changed how the stream on a mesh splits its pieces (in two at the longest edge,
+    where 3-6 split in four): pinning 6 keeps the older points; runs are the same under both."""
+    m = trimesh.creation.icosphere(subdivisions=2)
+    current = vpds.sample_mesh(m, radius=0.2, n=80, rng=3)
+    np.testing.assert_array_equal(vpds.sample_mesh(m, radius=0.2, n=80, rng=3, algorithm_version=7).points,
+                                  current.points)
+    pinned = vpds.sample_mesh(m, radius=0.2, n=80, rng=3, algorithm_version=6)
+    assert not np.array_equal(pinned.points, current.points)
+    for version in (3, 4, 5):
+        np.testing.assert_array_equal(
+            vpds.sample_mesh(m, radius=0.2, n=80, rng=3, algorithm_version=version).points, pinned.points)
+    np.testing.assert_array_equal(vpds.sample_mesh(m, radius=0.2, rng=3, algorithm_version=6).points,
+                                  vpds.sample_mesh(m, radius=0.2, rng=3).points)
+    for bad in (2, 8, -1, 1.5, True):
+        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 3\.\.7"):
+            vpds.sample_mesh(m, algorithm_version=bad)
+
+
 def bunny_scan():
     """The Stanford bunny as scanned and reconstructed (50,000 vertices, 99,785 triangles, in
     millimetres, open where the scanner saw nothing): the PLY file pymeshfix ships (a test

@@ -220,9 +220,10 @@ def test_algorithm_version_pins_the_points():
     one radius is the same under both; version 3 changed only the stream (a run's points are
     those of version 2); version 4 made the search learn, with the points of version 3;
     version 5 made the stream of one radius exact (its runs are version 4's); version 6 made the
-    two-radii search skip the sub-boxes it showed covered (the points of 5 here); a version the
-    library does not have is refused."""
-    assert vpds.ALGORITHM_VERSION == 6
+    two-radii search skip the sub-boxes it showed covered (the points of 5 here); version 7
+    changed only the stream on meshes (boxes give the points of 6); a version the library does
+    not have is refused."""
+    assert vpds.ALGORITHM_VERSION == 7
 
     def fill(version, inhibition):
         engine = vpds.PoissonDisk(2, sizing=lambda x: 0.04 + 0.04 * x[:, 0], lipschitz=0.04,
@@ -234,6 +235,7 @@ def test_algorithm_version_pins_the_points():
     assert np.array_equal(current, fill(4, 0.6))
     assert np.array_equal(current, fill(5, 0.6))
     assert np.array_equal(current, fill(6, 0.6))
+    assert np.array_equal(current, fill(7, 0.6))
     assert np.array_equal(current, v3)
     assert np.array_equal(v2, v3)
     assert not np.array_equal(v1, v2)
@@ -246,7 +248,8 @@ def test_algorithm_version_pins_the_points():
     # the stream: version 5's farthest points differ from version 4's (to the tolerance)
     assert np.array_equal(stream(None), stream(5))
     assert np.array_equal(stream(6), stream(5))
+    assert np.array_equal(stream(7), stream(5))
     assert not np.array_equal(stream(5), stream(4))
-    for bad in (7, -1, 1.5, True):
-        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.6"):
+    for bad in (8, -1, 1.5, True):
+        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.7"):
             vpds.PoissonDisk(2, algorithm_version=bad)

@@ -25,6 +25,17 @@ __all__ = ["PoissonDisk", "SizingGrid", "VpdsError", "VpdsSizingError", "VpdsDom
 
 #: the algorithm version of this library: the points a seed gives (`algorithm_version` pins one)
 ALGORITHM_VERSION: int = int(lib.VPDS_ALGORITHM_VERSION)
+
+
+def _algorithm_version(version: Any, first: int) -> int:
+    """desc.algorithm_version from an argument: None or 0 the current one, else first..current."""
+    if version is None:
+        return 0
+    if (not isinstance(version, (int, np.integer)) or isinstance(version, bool)
+            or not (version == 0 or first <= version <= ALGORITHM_VERSION)):
+        raise ValueError(f"algorithm_version = {version!r}: this library has versions "
+                         f"{first}..{ALGORITHM_VERSION} (0 or None: the current one)")
+    return int(version)
 #: the largest dimension the library samples (VPDS_MAX_DIM)
 MAX_DIM: int = int(lib.VPDS_MAX_DIM)
 # work units (darts + cells) per C call in a fill: small enough for a responsive Ctrl-C and
@@ -243,12 +254,7 @@ class PoissonDisk:
         desc.inhibition = float(inhibition)
         desc.coverage = float(coverage)
         desc.weighted = 1 if weighted else 0
-        if algorithm_version is not None:
-            if (not isinstance(algorithm_version, (int, np.integer)) or isinstance(algorithm_version, bool)
-                    or not 0 <= algorithm_version <= ALGORITHM_VERSION):
-                raise ValueError(f"algorithm_version = {algorithm_version!r}: this library has "
-                                 f"versions 1..{ALGORITHM_VERSION} (0 or None: the current one)")
-            desc.algorithm_version = int(algorithm_version)
+        desc.algorithm_version = _algorithm_version(algorithm_version, 1)
         if memory_limit is not None and (not isinstance(memory_limit, (int, np.integer))
                                          or isinstance(memory_limit, bool) or memory_limit < 0):
             raise ValueError(f"memory_limit = {memory_limit!r}: must be an int number of bytes >= 0 "

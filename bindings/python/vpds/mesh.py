@@ -20,7 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ._callbacks import take, raise_failure
-from ._core import RULES, _CHUNK
+from ._core import RULES, _CHUNK, _algorithm_version
 from ._errors import _raise, created
 from ._scipy_compat import _seed_from
 from ._typing import RngLike, SizingFunction
@@ -29,6 +29,7 @@ from ._vpds import ffi, lib
 __all__ = ["MeshSamples", "sample_mesh", "MeshSampler"]
 
 FloatArray = npt.NDArray[np.float64]
+_MESH_ALGORITHM_FIRST = 3  # meshes came with algorithm version 3
 
 
 class MeshSamples(NamedTuple):
@@ -72,7 +73,8 @@ class MeshSampler:
     def __init__(self, vertices: Any, faces: Any = None, *, radius: float = 0.05,
                  sizing: Optional[SizingFunction] = None, vertex_radii: Optional[npt.ArrayLike] = None,
                  lipschitz: Optional[float] = None, rule: str = "smaller", inhibition: float = 1.0,
-                 coverage: float = 1.0, rng: RngLike = None) -> None:
+                 coverage: float = 1.0, rng: RngLike = None,
+                 algorithm_version: Optional[int] = None) -> None:
         v, f = _mesh_arrays(vertices, faces)
         if rule not in RULES:
             raise ValueError(f"rule = {rule!r}: one of {sorted(RULES)}")
@@ -106,6 +108,7 @@ class MeshSampler:
         desc.inhibition = float(inhibition)
         desc.coverage = float(coverage)
         desc.seed = _seed_from(rng)
+        desc.algorithm_version = _algorithm_version(algorithm_version, _MESH_ALGORITHM_FIRST)
         self._m = created(lib.vpds_mesh_validate, lib.vpds_mesh_create, lib.vpds_mesh_destroy,
                           "vpds_mesh", desc)
         self.n_faces = len(f)
@@ -174,7 +177,7 @@ def sample_mesh(vertices: Any, faces: Any = None, *, radius: float = 0.05,
                 sizing: Optional[SizingFunction] = None, vertex_radii: Optional[npt.ArrayLike] = None,
                 lipschitz: Optional[float] = None, rule: str = "smaller", inhibition: float = 1.0,
                 coverage: float = 1.0, rng: RngLike = None, t: Union[float, int] = 1.0,
-                n: Optional[int] = None) -> MeshSamples:
+                n: Optional[int] = None, algorithm_version: Optional[int] = None) -> MeshSamples:
     """A maximal Poisson-disk sampling of a triangle mesh.
 
     vertices, faces: (n, 3) coordinates and (m, 3) vertex indices, or a trimesh.Trimesh (or any
@@ -184,10 +187,13 @@ def sample_mesh(vertices: Any, faces: Any = None, *, radius: float = 0.05,
     version needs inhibition == coverage). rng: an int seed (the C seed) or a numpy Generator.
     t: the scale (1: the radius itself). n: exactly n points instead, evenly spread: the first n
     samples of the stream on the surface (`scales` then says the scale each prefix reaches; the
-    radius sets only the shape of the spacing, r relative to itself).
+    radius sets only the shape of the spacing, r relative to itself). algorithm_version: pin the
+    points a seed gives (3..vpds.ALGORITHM_VERSION; None: the current one; 7 changed the
+    stream's points, so `n=` differs from 6).
     """
     m = MeshSampler(vertices, faces, radius=radius, sizing=sizing, vertex_radii=vertex_radii,
-                    lipschitz=lipschitz, rule=rule, inhibition=inhibition, coverage=coverage, rng=rng)
+                    lipschitz=lipschitz, rule=rule, inhibition=inhibition, coverage=coverage, rng=rng,
+                    algorithm_version=algorithm_version)
     if n is not None:
         if float(t) != 1.0:
             raise ValueError(f"n = {n} with t = {t}: give one (n points from the stream, or a run at t)")
