@@ -11,7 +11,7 @@
  *          and largest tile, and the bounds it gives for 2, 16, 64, 1024 workers)
  *        | mesh square|sphere RADIUS (the unit square as two triangles, or the unit sphere as an
  *          icosahedron split into 40^2 triangles per face: vpds_mesh_run)
- *        | meshstream N (N calls of vpds_mesh_next on that sphere)
+ *        | meshstream N [VERSION] (N calls of vpds_mesh_next on that sphere, at an algorithm version)
  *        | meshfile FILE RADIUS (vertices and triangles from a text file: "nv nt", then nv lines
  *          of x y z, then nt lines of i j k) */
 #include "rng.h"
@@ -252,7 +252,7 @@ static int run_mesh(const char *name, const double *v, size_t nv, const uint32_t
 }
 
 /* The stream on the unit sphere: n calls of vpds_mesh_next. */
-static int mesh_stream(size_t n)
+static int mesh_stream(size_t n, unsigned version)
 {
     vpds_mesh_desc md = vpds_default_mesh_desc();
     vpds_mesh *m;
@@ -266,6 +266,7 @@ static int mesh_stream(size_t n)
     md.n_triangles = nt;
     md.radius = 1;
     md.seed = 1;
+    md.algorithm_version = version;
     if (vpds_mesh_create(&md, &m) != VPDS_OK) return 1;
     t0 = now();
     for (i = 0; i < n; i++)
@@ -393,7 +394,7 @@ int main(int argc, char **argv)
         free(t);
         return rc;
     }
-    if (argc >= 3 && !strcmp(argv[1], "meshstream")) return mesh_stream((size_t)atof(argv[2]));
+    if (argc >= 3 && !strcmp(argv[1], "meshstream")) return mesh_stream((size_t)atof(argv[2]), argc >= 4 ? (unsigned)atoi(argv[3]) : 0);
     if (argc >= 4 && !strcmp(argv[1], "meshfile")) return mesh_file(argv[2], atof(argv[3]));
     if (argc >= 4 && !strcmp(argv[1], "floor")) {
         /* the floor: as many uniform random points with the library's own generator */
@@ -410,6 +411,6 @@ int main(int argc, char **argv)
         return 0;
     }
     fprintf(stderr, "usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION | ramp RULE | rampthreads RULE TX TY THREADS"
-                    " | tworamp3 VERSION | floor N DIM | stream DIM RADIUS N STEPS [VERSION [INHIBITION]] | streamramp RULE N STEPS [VERSION] | mesh square|sphere RADIUS | meshstream N | meshfile FILE RADIUS\n");
+                    " | tworamp3 VERSION | floor N DIM | stream DIM RADIUS N STEPS [VERSION [INHIBITION]] | streamramp RULE N STEPS [VERSION] | mesh square|sphere RADIUS | meshstream N [VERSION] | meshfile FILE RADIUS\n");
     return 2;
 }

@@ -56,8 +56,9 @@ extern "C" {
  * children from the one farthest from the dart (other points with two radii, where the search's
  * box budget decided). 7: the stream on a mesh (vpds_mesh_next) splits a piece in two at its
  * longest edge instead of in four at its edges' midpoints, so that a needle's pieces get shorter
- * without getting thinner (other points for vpds_mesh_next; the runs and every box give the
- * points of version 6). */
+ * without getting thinner, and with a constant radius it inserts the exact farthest point (from
+ * the few samples near a small piece) instead of one within the tolerance (other points for
+ * vpds_mesh_next; the runs and every box give the points of version 6). */
 #define VPDS_ALGORITHM_VERSION 7
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 16
@@ -556,7 +557,9 @@ VPDS_API vpds_status vpds_mesh_refine(vpds_mesh *mesh, double t);
 /* The continuous stream on the surface (exactly n points: call it n times): the point farthest
  * from the samples in the rule's scaled distance, found by branch and bound, with its scale t
  * (+INFINITY for the first sample, uniform by area). Each prefix {x_k : t_k >= t} covers the
- * surface at t * coverage and keeps conflict-free at t * inhibition * (1 - VPDS_STREAM_TOLERANCE).
+ * surface at t * coverage and keeps conflict-free at t * inhibition * (1 - VPDS_STREAM_TOLERANCE);
+ * with a constant radius (algorithm version 7 on) each sample is the exact farthest point, so
+ * conflict-free at t * inhibition up to round-off.
  * VPDS_STREAM_END: the next sample's t would be at or below t_min (nothing consumed). From an
  * empty mesh sampler or a completed run (its t caps the scales; a paused run: VPDS_ERR_STATE);
  * each event leaves the samples maximal at its t, so vpds_mesh_run then has nothing to add and

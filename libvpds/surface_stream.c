@@ -2,20 +2,23 @@
  * bound over pieces of the triangles (each triangle one piece at level 0, m = 1). */
 #include "surface_stream.h"
 #include "rules.h"
+#include "surface_gap.h"
 #include <math.h>
 #include <string.h>
 
 #define STREAM_MAX_LEVEL 52 /* lattice coordinates below 2^52 stay exact */
 
-void vpdsi_surface_stream_init(vpdsi_surface_stream *ss, uint32_t algorithm_version)
+void vpdsi_surface_stream_init(vpdsi_surface_stream *ss, uint32_t algorithm_version, int constant_radius)
 {
     memset(ss, 0, sizeof *ss);
     ss->bisect = algorithm_version >= 7;
+    ss->exact = ss->bisect && constant_radius;
 }
 
 void vpdsi_surface_stream_release(vpdsi_surface_stream *ss, vpdsi_mem *m)
 {
     vpdsi_mem_free(m, ss->heap, ss->cap_heap * sizeof *ss->heap);
+    vpdsi_mem_free(m, ss->cand, ss->cap_cand * sizeof *ss->cand);
     memset(ss, 0, sizeof *ss);
 }
 
@@ -78,6 +81,53 @@ static vpds_status piece_upper_bound(const vpdsi_surface_ctx *ctx, const vpdsi_s
     memcpy(uv, p->uv, sizeof uv);
     if ((e = vpdsi_piece_bounds(ctx->mesh, ctx->st, p->tri, uv, x, &r_lo, &r_hi)) != VPDS_OK) return e;
     *ub = vpdsi_kd_min_ratio(&ctx->st->tree, &v, c, h, r_lo, (int)ctx->rule, &arg);
+    return VPDS_OK;
+}
+
+/* A constant radius (ss->exact): the largest gap of the piece exactly, into *pt (g, r and where),
+ * when the piece is small beside its nearest sample (h <= half its distance): only the samples
+ * within that distance + 2h of the centre can be nearest in it, and few are. *done = 0 when the
+ * piece is larger or too many samples are near (it splits instead). */
+static vpds_status piece_exact(vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ctx,
+                               const vpdsi_surface_heap_entry *p, int *done, vpdsi_surface_best *pt)
+{
+    vpdsi_kd_samples v = vpdsi_store_view(ctx->st);
+    double x[3][3], cuv[2], c[3], e1[3], e2[3], z[3 * VPDSI_SURFACE_GAP_MAX_POINTS], ab[2], gap2 = INFINITY;
+    double r = ctx->st->sizing.radius, h = piece_centre(ctx->mesh, p, x, cuv, c), near;
+    int32_t arg;
+    size_t i;
+    int k;
+    *done = 0;
+    near = vpdsi_kd_min_ratio(&ctx->st->tree, &v, c, 0, r, (int)ctx->rule, &arg) * r;
+    if (!(h <= 0.5 * near)) return VPDS_OK;
+    ss->n_cand = 0;
+    if (vpdsi_kd_radius(&ctx->st->tree, &v, c, (near + 2 * h) * (1 + 1e-9), ctx->st->mem, &ss->cand,
+                        &ss->n_cand, &ss->cap_cand)) {
+        vpdsi_store_error(ctx->st, "out of memory for the stream's search");
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    if (ss->n_cand < 1 || ss->n_cand > VPDSI_SURFACE_GAP_MAX_POINTS) return VPDS_OK;
+    for (k = 0; k < 3; k++) {
+        e1[k] = x[1][k] - x[0][k];
+        e2[k] = x[2][k] - x[0][k];
+    }
+    for (i = 0; i < ss->n_cand; i++)
+        for (k = 0; k < 3; k++) z[3 * i + k] = ctx->st->x[3 * (size_t)ss->cand[i] + k] - x[0][k];
+    vpdsi_surface_gap_max(e1, e2, z, (int)ss->n_cand, ab);
+    for (k = 0; k < 2; k++)
+        pt->uv[k] = p->uv[0][k] + ab[0] * (p->uv[1][k] - p->uv[0][k]) + ab[1] * (p->uv[2][k] - p->uv[0][k]);
+    vpdsi_trimesh_point(ctx->mesh, p->tri, pt->uv, pt->x);
+    /* g where the sample goes: the gap of its own coordinates */
+    for (i = 0; i < ss->n_cand; i++) {
+        const double *xi = ctx->st->x + 3 * (size_t)ss->cand[i];
+        double d2 = 0;
+        for (k = 0; k < 3; k++) d2 += (pt->x[k] - xi[k]) * (pt->x[k] - xi[k]);
+        if (d2 < gap2) gap2 = d2;
+    }
+    pt->g = sqrt(gap2) / r;
+    pt->r = r;
+    pt->tri = p->tri;
+    *done = 1;
     return VPDS_OK;
 }
 
@@ -298,10 +348,23 @@ static int may_split(const vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ct
            ldexp(ctx->mesh->longest[p->tri], -(int)p->level) >= 2 * ctx->mesh->min_edge;
 }
 
+/* Insert *pt at scale t (its g over the coverage, capped by a run's scale). */
+static vpds_status emit(const vpdsi_surface_ctx *ctx, vpdsi_surface_best *pt, double t, double *x_out,
+                        double *t_out)
+{
+    vpds_status e;
+    if ((e = vpdsi_marks_reserve(ctx->marks, ctx->st, 1)) != VPDS_OK) return e;
+    vpdsi_marks_append(ctx->marks, ctx->st, ctx->mesh, pt->tri, pt->uv, pt->x, pt->r, t);
+    ctx->stats->accepted++;
+    memcpy(x_out, pt->x, sizeof pt->x);
+    *t_out = t;
+    return VPDS_OK;
+}
+
 vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ctx,
                                double t_min, double t_max, double *x_out, double *t_out)
 {
-    vpdsi_surface_best *best = &ss->best;
+    vpdsi_surface_best *best = &ss->best, exact_pt;
     vpds_status e;
     /* a run may have filed its samples in another index: the bounds read the kd-tree */
     if ((e = vpdsi_store_sync_tree(ctx->st)) != VPDS_OK) return e;
@@ -311,9 +374,30 @@ vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx
         if ((e = reserve_heap(ss, ctx)) != VPDS_OK) return e;
         start_heap(ss, ctx->mesh);
     }
+    /* scales never rise: two pieces' exact gaps at one point may differ in the last bits */
+    if (ss->bisect && ctx->st->n > 0 && ctx->st->t[ctx->st->n - 1] < t_max) t_max = ctx->st->t[ctx->st->n - 1];
     for (;;) {
         double ub, t;
+        int exact = 0;
+        if (ss->exact && (e = piece_exact(ss, ctx, &ss->heap[0], &exact, &exact_pt)) != VPDS_OK) return e;
+        if (exact) {
+            /* its largest gap, below the bound it had if a sample came near since */
+            if (exact_pt.g < ss->heap[0].ub * (1 - 1e-12)) {
+                ss->heap[0].ub = exact_pt.g;
+                heap_sift_down(ss->heap, ss->n_heap, 0);
+                continue;
+            }
+            /* at or above every other piece's bound: the farthest point of the surface */
+            t = exact_pt.g / ctx->coverage < t_max ? exact_pt.g / ctx->coverage : t_max;
+            if (!(t > t_min)) return VPDS_STREAM_END;
+            if ((e = emit(ctx, &exact_pt, t, x_out, t_out)) != VPDS_OK) return e;
+            best->g = -1;
+            return VPDS_OK;
+        }
         if ((e = piece_upper_bound(ctx, &ss->heap[0], &ub)) != VPDS_OK) return e;
+        /* from version 7 the bound kept (a parent's, or taken before) holds too: the smaller is
+         * the bound, so scales never rise (a half's own bound can exceed its parent's) */
+        if (ss->bisect && ub > ss->heap[0].ub) ub = ss->heap[0].ub;
         if (ub < ss->heap[0].ub) {
             /* a sample came nearer since the bound was taken: it falls back in the heap */
             ss->heap[0].ub = ub;
@@ -323,14 +407,11 @@ vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx
         /* after a run at t_max, maximal there up to its precision: no event above it */
         t = ub / ctx->coverage < t_max ? ub / ctx->coverage : t_max;
         if (!(t > t_min)) return VPDS_STREAM_END;
-        /* ub bounds g over the whole surface: a point within the tolerance of it is the next */
+        /* ub bounds g over the whole surface: a point within the tolerance of it is the next
+         * (with the exact search, only where a piece can split no more) */
         if ((e = look_at_centre(ctx, &ss->heap[0], best)) != VPDS_OK) return e;
-        if (best->g >= ub * (1 - VPDS_STREAM_TOLERANCE) || !may_split(ss, ctx, &ss->heap[0])) {
-            if ((e = vpdsi_marks_reserve(ctx->marks, ctx->st, 1)) != VPDS_OK) return e;
-            vpdsi_marks_append(ctx->marks, ctx->st, ctx->mesh, best->tri, best->uv, best->x, best->r, t);
-            ctx->stats->accepted++;
-            memcpy(x_out, best->x, sizeof best->x);
-            *t_out = t;
+        if ((!ss->exact && best->g >= ub * (1 - VPDS_STREAM_TOLERANCE)) || !may_split(ss, ctx, &ss->heap[0])) {
+            if ((e = emit(ctx, best, t, x_out, t_out)) != VPDS_OK) return e;
             best->g = -1; /* new sample: every g seen is stale */
             return VPDS_OK;
         }

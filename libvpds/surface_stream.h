@@ -5,7 +5,9 @@
  * the top one refreshed, then accepted at its centroid when g there is within
  * VPDS_STREAM_TOLERANCE of the bound, else split: in four at its edges' midpoints (algorithm
  * versions 3-6), or in two at the midpoint of its longest edge (7 on), so that a needle's pieces
- * get shorter without getting thinner. The first sample is uniform by area. */
+ * get shorter without getting thinner. From version 7 with a constant radius a piece small beside
+ * its nearest sample takes its largest gap exactly from the few samples near it, and the stream
+ * inserts exact farthest points. The first sample is uniform by area. */
 #ifndef VPDS_SURFACE_STREAM_H
 #define VPDS_SURFACE_STREAM_H
 #include "pieces.h"
@@ -28,14 +30,18 @@ typedef struct vpdsi_surface_best {
 
 typedef struct vpdsi_surface_stream {
     int bisect;              /* split in two at the longest edge (version 7 on), else in four */
+    int exact;               /* a constant radius from version 7: small pieces find their
+                                largest gap exactly (surface_gap.h), not to the tolerance */
     int started;             /* the first sample is placed */
     vpdsi_surface_best best; /* kept across calls that fail or end: the samples are the same */
     vpdsi_surface_heap_entry *heap;
     size_t n_heap, cap_heap;
+    int32_t *cand;           /* scratch: the samples near a piece */
+    size_t n_cand, cap_cand;
 } vpdsi_surface_stream;
 
-/* An empty stream for the mesh's algorithm version. */
-void vpdsi_surface_stream_init(vpdsi_surface_stream *ss, uint32_t algorithm_version);
+/* An empty stream for the mesh's algorithm version; constant_radius: r is one value everywhere. */
+void vpdsi_surface_stream_init(vpdsi_surface_stream *ss, uint32_t algorithm_version, int constant_radius);
 void vpdsi_surface_stream_release(vpdsi_surface_stream *ss, vpdsi_mem *m);
 /* The next sample into x_out (3 doubles), its scale into *t_out: VPDS_OK, or VPDS_STREAM_END when
  * its scale would be at or below t_min (nothing consumed), or an error (nothing consumed). The

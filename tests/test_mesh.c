@@ -850,7 +850,7 @@ static size_t uncovered_probes(const mesh_t *m, const double *vr, radius_fn rf, 
 }
 
 /* The stream on a surface: n samples, t non-increasing, each prefix covered at its t and
- * conflict-free within the stream's tolerance, by brute force; determinism, STREAM_END consuming
+ * conflict-free within the stream's tolerance (exactly with a constant radius), by brute force; determinism, STREAM_END consuming
  * nothing, a paused run refusing to stream, every allocation failing once. */
 static void stream_case(const char *what, const mesh_t *m, const double *vr, radius_fn rf, vpds_rule rule,
                         double radius, size_t n)
@@ -881,7 +881,10 @@ static void stream_case(const char *what, const mesh_t *m, const double *vr, rad
     for (j = 1; j < vpds_mesh_count(s); j++)
         for (i = 0; i < j; i++) {
             const double *xs = vpds_mesh_points(s), *rs = vpds_mesh_radii(s), *ts = vpds_mesh_scales(s);
-            double d2 = 0, fr = ts[j] * rule_f(rule, rs[i], rs[j]) * (1 - VPDS_STREAM_TOLERANCE);
+            /* a constant radius (version 7): each sample the exact farthest point, at t r from the
+             * nearest before it up to round-off; else within the stream's tolerance */
+            double tol = vr == NULL && rf == r_const ? 1e-12 : VPDS_STREAM_TOLERANCE;
+            double d2 = 0, fr = ts[j] * rule_f(rule, rs[i], rs[j]) * (1 - tol);
             int q;
             for (q = 0; q < 3; q++) d2 += (xs[3 * i + q] - xs[3 * j + q]) * (xs[3 * i + q] - xs[3 * j + q]);
             conflicts += d2 < fr * fr;
