@@ -8,6 +8,7 @@
 #include "check.h"
 #include "vpds.h"
 #include "gap_search.h"
+#include "surface_gap.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -86,6 +87,50 @@ static void check_gap_once(int d, int n, int probes)
         CHECK_MSG(fabs(found - v) <= 1e-12 * v, "d %d n %d: pieces found %.17g, the box %.17g", d, n,
                   found, v);
     }
+}
+
+/* The triangle form (surface_gap.c): a random triangle of R^3 and n points near it, some off its
+ * plane. The reported gap is the gap at the reported point, no probe of the triangle (a third on
+ * its edges, its corners) beats it, and the best probe of a fine lattice comes within the
+ * lattice's spacing of it (the gap is 1-Lipschitz). */
+static void check_triangle_gap_once(int n, int lattice)
+{
+    double e1[3], e2[3], z[3 * VPDSI_SURFACE_GAP_MAX_POINTS], ab[2], v, top = 0, edge = 0;
+    int i, j, k;
+    for (k = 0; k < 3; k++) {
+        e1[k] = unit() * 2 - 1;
+        e2[k] = unit() * 2 - 1;
+    }
+    for (i = 0; i < n; i++) {
+        double a = unit() * 1.4 - 0.2, b = unit() * 1.4 - 0.2, off = (unit() - 0.5) * 0.6;
+        for (k = 0; k < 3; k++) z[3 * i + k] = a * e1[k] + b * e2[k] + off * (k == 2 ? 1 : 0.3);
+    }
+    v = vpdsi_surface_gap_max(e1, e2, z, n, ab);
+    CHECK(ab[0] >= 0 && ab[1] >= 0 && ab[0] + ab[1] <= 1);
+    {
+        double y[3];
+        for (k = 0; k < 3; k++) y[k] = ab[0] * e1[k] + ab[1] * e2[k];
+        CHECK_MSG(fabs(nearest2(3, z, n, y) - v) <= 1e-12 * v, "triangle n %d: gap at the point %.17g, reported %.17g",
+                  n, nearest2(3, z, n, y), v);
+    }
+    for (k = 0; k < 3; k++) {
+        double l1 = 0, l2 = 0, l3 = 0;
+        l1 += e1[k] * e1[k];
+        l2 += e2[k] * e2[k];
+        l3 += (e1[k] - e2[k]) * (e1[k] - e2[k]);
+        edge += l1 + l2 + l3;
+    }
+    edge = sqrt(edge); /* at least the longest edge */
+    for (i = 0; i <= lattice; i++)
+        for (j = 0; i + j <= lattice; j++) {
+            double y[3], g;
+            for (k = 0; k < 3; k++) y[k] = ((double)i * e1[k] + (double)j * e2[k]) / lattice;
+            g = nearest2(3, z, n, y);
+            if (g > top) top = g;
+        }
+    CHECK_MSG(top <= v * (1 + 1e-12), "triangle n %d: a probe's gap %.17g beats the maximum %.17g", n, top, v);
+    CHECK_MSG(sqrt(v) - sqrt(top) <= edge / lattice, "triangle n %d: the maximum %.17g, the lattice's best %.17g",
+              n, sqrt(v), sqrt(top));
 }
 
 /* Known answers: a lone point's farthest corner; a triangle's circumcentre. */
@@ -343,6 +388,8 @@ int main(void)
         for (n = 1; n <= VPDSI_GAP_MAX_POINTS; n++)
             for (rep = 0; rep < (quick ? 5 : d > 2 ? 40 : 100); rep++) check_gap_once(d, n, d > 2 ? 3000 : 2000);
     }
+    for (n = 1; n <= VPDSI_SURFACE_GAP_MAX_POINTS; n++)
+        for (rep = 0; rep < (quick ? 5 : 60); rep++) check_triangle_gap_once(n, quick ? 60 : 200);
     check_search();
     check_stream_brute(1, 0, 64);
     check_stream_brute(1, 1, 64);
