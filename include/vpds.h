@@ -58,7 +58,9 @@ extern "C" {
  * longest edge instead of in four at its edges' midpoints, so that a needle's pieces get shorter
  * without getting thinner, and with a constant radius it inserts the exact farthest point (from
  * the few samples near a small piece) instead of one within the tolerance (other points for
- * vpds_mesh_next; the runs and every box give the points of version 6). */
+ * vpds_mesh_next), and a sizing callback's largest radius is estimated from at most 4096
+ * probes in any dimension, not 3^d (other points for a sizing callback in 8 dimensions and up;
+ * every other box gives the points of version 6). */
 #define VPDS_ALGORITHM_VERSION 7
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 16

@@ -94,8 +94,8 @@ const char *vpds_last_error(const vpds_sampler *s)
 
 static vpds_status ensure_rmax(vpds_sampler *s)
 {
-    return vpdsi_sizing_estimate_rmax(&s->store.sizing, &s->mem, s->pb.lo, s->pb.hi, s->store.err,
-                                      sizeof s->store.err);
+    return vpdsi_sizing_estimate_rmax(&s->store.sizing, &s->mem, s->pb.lo, s->pb.hi, s->pb.algorithm >= 7,
+                                      s->store.err, sizeof s->store.err);
 }
 
 /* Before a run at scale t, one estimate (vpds_estimate) serves two ends: a run whose estimate

@@ -1,4 +1,5 @@
 #include "sizing.h"
+#include "rng.h"
 #include <math.h>
 #include <stdio.h>
 
@@ -98,17 +99,23 @@ vpds_status vpdsi_sizing_from_desc(vpdsi_sizing *s, const vpds_desc *d)
     return VPDS_OK;
 }
 
+#define RMAX_PROBES 4096
+
 /* The lattice where r_max is read: per^d points, per from 3 up while per^d * (per + 1) <= 4096
- * (so 3^d points from 7 dimensions on: 43 million in 16). */
-static size_t rmax_lattice(int d, int *per)
+ * (so 3^d points from 7 dimensions on: 43 million in 16); capped (version 7 on), 4096 of them
+ * at most, chosen by a hash (*hashed). */
+static size_t rmax_lattice(int d, int capped, int *per, int *hashed)
 {
     size_t n = 1;
     int k;
     *per = 2;
-    while (*per < 64 && n * (size_t)(*per + 1) <= 4096) {
+    while (*per < 64 && n * (size_t)(*per + 1) <= RMAX_PROBES) {
         (*per)++;
         for (n = 1, k = 0; k < d; k++) n *= (size_t)*per;
     }
+    for (n = 1, k = 0; k < d && n <= RMAX_PROBES; k++) n *= (size_t)*per;
+    *hashed = capped && n > RMAX_PROBES;
+    if (*hashed) return RMAX_PROBES;
     for (n = 1, k = 0; k < d; k++) n *= (size_t)*per;
     return n;
 }
@@ -119,7 +126,8 @@ static size_t rmax_lattice(int d, int *per)
  * r_max, in memory that does not grow with 3^d (5.8 GB in 16 dimensions when it was whole). */
 #define RMAX_CHUNK 4096
 
-static void rmax_points(const double *lo, const double *hi, int d, int per, size_t first,
+/* Lattice points first..first + n - 1: the digits of the index, or of a hash of it and the axis. */
+static void rmax_points(const double *lo, const double *hi, int d, int per, int hashed, size_t first,
                         size_t n, double *pts)
 {
     size_t i;
@@ -128,18 +136,19 @@ static void rmax_points(const double *lo, const double *hi, int d, int per, size
         size_t rest = first + i;
         for (k = 0; k < d; k++) {
             size_t j = rest % (size_t)per;
-            rest /= (size_t)per;
+            if (hashed) j = (size_t)(vpdsi_mix64((uint64_t)(first + i) * VPDS_MAX_DIM + (uint64_t)k) % (uint64_t)per);
+            else rest /= (size_t)per;
             pts[i * (size_t)d + (size_t)k] = lo[k] + (hi[k] - lo[k]) * (double)j / (double)(per - 1);
         }
     }
 }
 
 vpds_status vpdsi_sizing_estimate_rmax(vpdsi_sizing *s, vpdsi_mem *m, const double *lo,
-                                       const double *hi, char *err, size_t cap)
+                                       const double *hi, int capped, char *err, size_t cap)
 {
     double c[VPDS_MAX_DIM] = {0}, rc, diag2 = 0, best = 0, *pts, *r;
-    int k, d = s->dim, per;
-    size_t n = rmax_lattice(d, &per), chunk = n < RMAX_CHUNK ? n : RMAX_CHUNK, i, done, bytes;
+    int k, d = s->dim, per, hashed;
+    size_t n = rmax_lattice(d, capped, &per, &hashed), chunk = n < RMAX_CHUNK ? n : RMAX_CHUNK, i, done, bytes;
     vpds_status st;
     if (s->rmax > 0) return VPDS_OK;
     for (k = 0; k < d; k++) {
@@ -155,7 +164,7 @@ vpds_status vpdsi_sizing_estimate_rmax(vpdsi_sizing *s, vpdsi_mem *m, const doub
     r = pts + chunk * (size_t)d;
     for (done = 0; st == VPDS_OK && done < n; done += chunk) {
         size_t take = n - done < chunk ? n - done : chunk;
-        rmax_points(lo, hi, d, per, done, take, pts);
+        rmax_points(lo, hi, d, per, hashed, done, take, pts);
         st = vpdsi_sizing_eval(s, pts, take, r, err, cap);
         for (i = 0; st == VPDS_OK && i < take; i++)
             if (r[i] > best) best = r[i];

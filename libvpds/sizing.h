@@ -37,9 +37,10 @@ typedef struct vpdsi_sizing {
 void vpdsi_sizing_bounds(const vpds_desc *d, double *L, double *rmin, double *rmax);
 /* The sizing of a descriptor (a grid is cloned through the allocator a). */
 vpds_status vpdsi_sizing_from_desc(vpdsi_sizing *s, const vpds_desc *d);
-/* Unknown r_max with a callback: estimate it over the box [lo, hi] (see sizing.c). */
+/* Unknown r_max with a callback: estimate it over the box [lo, hi] (see sizing.c); capped:
+ * at most 4096 probes in any dimension (algorithm version 7 on), else 3^d from 7 dimensions. */
 vpds_status vpdsi_sizing_estimate_rmax(vpdsi_sizing *s, vpdsi_mem *m, const double *lo,
-                                       const double *hi, char *err, size_t cap);
+                                       const double *hi, int capped, char *err, size_t cap);
 /* r at n points into out. On a bad value returns VPDS_ERR_SIZING and says where in err. */
 vpds_status vpdsi_sizing_eval(vpdsi_sizing *s, const double *x, size_t n, double *out, char *err,
                               size_t cap);

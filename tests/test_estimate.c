@@ -187,10 +187,11 @@ static void largest_free(void *p, size_t size, void *user)
     free(p);
 }
 
-/* r_max of a sizing is read on a lattice of 3^d points from 7 dimensions on (531,441 in 12D,
- * 43 million in 16D); it is read in chunks, so the memory for it does not grow with 3^d (it was
- * one 55 MB block in 12D and 5.8 GB in 16D: the fuzzers' out-of-memory). */
-static void check_rmax_memory(void)
+/* r_max of a sizing was read on a lattice of 3^d points from 7 dimensions on (531,441 in 12D,
+ * 43 million in 16D): version 6 reads it in chunks, so its memory does not grow with 3^d (it
+ * was one 55 MB block in 12D and 5.8 GB in 16D: the fuzzers' out-of-memory); version 7 reads at
+ * most 4096 probes in any dimension. */
+static void check_rmax_memory(uint32_t version, double max_calls)
 {
     vpds_desc d = uniform(12, 3);
     vpds_sampler *s = NULL;
@@ -198,12 +199,16 @@ static void check_rmax_memory(void)
     size_t largest = 0;
     d.sizing = wide_ramp;
     d.lipschitz = 0.2;
+    d.algorithm_version = version;
     d.allocator.alloc = largest_alloc;
     d.allocator.free = largest_free;
     d.allocator.user = &largest;
     CHECK(vpds_create(&d, &s) == VPDS_OK);
     CHECK_MSG(vpds_estimate(s, 0, &e) == VPDS_OK, "%s", vpds_last_error(s));
-    CHECK_MSG(largest < 1024 * 1024, "12D sizing: a single allocation of %zu bytes", largest);
+    CHECK_MSG(largest < 1024 * 1024, "12D sizing, version %u: a single allocation of %zu bytes", version, largest);
+    CHECK_MSG((double)vpds_get_stats(s).sizing_calls <= max_calls && vpds_get_stats(s).sizing_calls > 4096,
+              "12D sizing, version %u: %llu sizing calls for r_max", version,
+              (unsigned long long)vpds_get_stats(s).sizing_calls);
     CHECK(vpds_set_budget(s, 200) == VPDS_OK);
     CHECK_MSG(vpds_run(s) == VPDS_PAUSED && vpds_count(s) > 0, "%s", vpds_last_error(s));
     vpds_destroy(s);
@@ -238,6 +243,7 @@ int main(void)
     check_bad_arguments();
     check_memory_limit();
     check_too_large();
-    check_rmax_memory();
+    check_rmax_memory(6, 531441 + 4096 + 16); /* and 4096 the estimate reads itself */
+    check_rmax_memory(7, 4096 + 4096 + 16);
     CHECK_DONE();
 }
