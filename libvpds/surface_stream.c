@@ -87,9 +87,11 @@ static vpds_status piece_upper_bound(const vpdsi_surface_ctx *ctx, const vpdsi_s
 /* A constant radius (ss->exact): the largest gap of the piece exactly, into *pt (g, r and where),
  * when the piece is small beside its nearest sample (h <= half its distance): only the samples
  * within that distance + 2h of the centre can be nearest in it, and few are. *done = 0 when the
- * piece is larger or too many samples are near (it splits instead). */
+ * piece is larger or too many samples are near (it splits instead); *bound then bounds g over
+ * it (piece_upper_bound's, from the same nearest-sample query). */
 static vpds_status piece_exact(vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ctx,
-                               const vpdsi_surface_heap_entry *p, int *done, vpdsi_surface_best *pt)
+                               const vpdsi_surface_heap_entry *p, int *done, vpdsi_surface_best *pt,
+                               double *bound)
 {
     vpdsi_kd_samples v = vpdsi_store_view(ctx->st);
     double x[3][3], cuv[2], c[3], e1[3], e2[3], z[3 * VPDSI_SURFACE_GAP_MAX_POINTS], ab[2], gap2 = INFINITY;
@@ -99,6 +101,8 @@ static vpds_status piece_exact(vpdsi_surface_stream *ss, const vpdsi_surface_ctx
     int k;
     *done = 0;
     near = vpdsi_kd_min_ratio(&ctx->st->tree, &v, c, 0, r, (int)ctx->rule, &arg) * r;
+    /* the bound piece_upper_bound takes, from the same query, for a piece that splits */
+    *bound = (near + h) / r * (1 + 1e-15);
     if (!(h <= 0.5 * near)) return VPDS_OK;
     ss->n_cand = 0;
     if (vpdsi_kd_radius(&ctx->st->tree, &v, c, (near + 2 * h) * (1 + 1e-9), ctx->st->mem, &ss->cand,
@@ -377,9 +381,9 @@ vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx
     /* scales never rise: two pieces' exact gaps at one point may differ in the last bits */
     if (ss->bisect && ctx->st->n > 0 && ctx->st->t[ctx->st->n - 1] < t_max) t_max = ctx->st->t[ctx->st->n - 1];
     for (;;) {
-        double ub, t;
+        double ub = -1, t;
         int exact = 0;
-        if (ss->exact && (e = piece_exact(ss, ctx, &ss->heap[0], &exact, &exact_pt)) != VPDS_OK) return e;
+        if (ss->exact && (e = piece_exact(ss, ctx, &ss->heap[0], &exact, &exact_pt, &ub)) != VPDS_OK) return e;
         if (exact) {
             /* its largest gap, below the bound it had if a sample came near since */
             if (exact_pt.g < ss->heap[0].ub * (1 - 1e-12)) {
@@ -394,7 +398,7 @@ vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx
             best->g = -1;
             return VPDS_OK;
         }
-        if ((e = piece_upper_bound(ctx, &ss->heap[0], &ub)) != VPDS_OK) return e;
+        if (ub < 0 && (e = piece_upper_bound(ctx, &ss->heap[0], &ub)) != VPDS_OK) return e;
         /* from version 7 the bound kept (a parent's, or taken before) holds too: the smaller is
          * the bound, so scales never rise (a half's own bound can exceed its parent's) */
         if (ss->bisect && ub > ss->heap[0].ub) ub = ss->heap[0].ub;
