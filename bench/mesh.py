@@ -7,8 +7,9 @@ count, given libvpds's), point-cloud-utils (`sample_mesh_poisson_disk`, by radiu
 (`igl.blue_noise`, by radius). For every output: samples/s, the pairs closer than the radius
 (conflicts), and the fraction of dense probes (area-uniform on the surface) farther than the
 radius from every sample (left uncovered: room for another point). A maximal conflict-free
-sampling has 0 and 0. Also the time per sample of a 2D box run of similar count (`bench
-uniform 2 R`) beside the flat square as a mesh (`bench mesh square R`).
+sampling has 0 and 0. Then exactly n points, the count the peers take (`exactly_n`). Also the
+time per sample of a 2D box run of similar count (`bench uniform 2 R`) beside the flat square as
+a mesh (`bench mesh square R`).
 
 usage: python bench/mesh.py [--quick]
 """
@@ -85,6 +86,39 @@ def bench_tool(*args: Any) -> tuple[int, float]:
     return int(out[1]), float(out[2])
 
 
+def exactly_n(v: np.ndarray, f: np.ndarray, probes: np.ndarray, pcu: Any, o3d: Any, n: int) -> None:
+    """Exactly n points on the mesh, the count peers take: libvpds's stream (`sample_mesh(n=)`)
+    beside Open3D and point-cloud-utils asked for n. For each: the smallest distance between two
+    points and the largest distance from a probe to its nearest point (the gap a further point
+    could fill); their ratio is at most 1 for the stream (each prefix is covered at its scale and
+    conflict-free at it), and the larger the smallest distance the more evenly n points spread."""
+    import vpds
+    from scipy.spatial import cKDTree
+    print(f"exactly {n:,d} points (the stream; peers asked for the count):")
+
+    def row(name: str, pts: np.ndarray, sec: float) -> None:
+        tree = cKDTree(pts)
+        dmin = float(tree.query(pts, k=2)[0][:, 1].min())
+        gap = float(tree.query(probes)[0].max())
+        print(f"  {name:34s} n={len(pts):>7,d} {sec:8.3f} s {len(pts) / sec:>10,.0f}/s  smallest distance "
+              f"{dmin:.5f}  largest gap {gap:.5f}  gap/distance {gap / dmin:5.3f}", flush=True)
+
+    pts, sec = timed(lambda: vpds.sample_mesh(v, f, radius=1.0, n=n, rng=1).points)
+    row("libvpds sample_mesh(n=)", pts, sec)
+    if pcu is not None:
+        def run_pcu() -> np.ndarray:
+            fi, bc = pcu.sample_mesh_poisson_disk(v, f.astype(np.int32), num_samples=n)
+            return pcu.interpolate_barycentric_coords(f.astype(np.int32), fi, bc, v)
+        pts, sec = timed(run_pcu)
+        row("point-cloud-utils (num_samples)", pts, sec)
+    if o3d is not None:
+        m = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(v), o3d.utility.Vector3iVector(f.astype(np.int32)))
+        if hasattr(o3d.utility, "random"):
+            o3d.utility.random.seed(1)
+        pts, sec = timed(lambda: np.asarray(m.sample_points_poisson_disk(number_of_points=n).points))
+        row("Open3D sample_points_poisson_disk", pts, sec)
+
+
 def main() -> None:
     import trimesh
     import vpds
@@ -127,6 +161,7 @@ def main() -> None:
     if peers:
         name, n, s = max(peers, key=lambda p: p[1] / p[2])
         print(f"libvpds / fastest peer ({name}) samples per second: {(n_vpds / t_vpds) / (n / s):.2f}")
+    exactly_n(v, f, probes, pcu, o3d, 5_000 if QUICK else 20_000)
     r_sq = 0.004 if QUICK else 0.002
     n_m, t_m = bench_tool("mesh", "square", r_sq)
     n_b, t_b = bench_tool("uniform", 2, r_sq)

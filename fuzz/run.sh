@@ -14,9 +14,8 @@
 #            seeds alone and takes the same time every time (make check-fuzz)
 # FUZZ_JOBS harnesses run side by side (default: the cores); their reports print in order.
 # FUZZ_SLOW=report (make check-fuzz): an input slower than TIMEOUT is shown and kept, but does
-# not fail the run: the library still has slow paths the fuzzers reach in seconds (the surface
-# stream on slivers: fuzz/open/mesh; issue 13's open item). Crashes, leaks, broken invariants and
-# OOM still fail.
+# not fail the run: mutants of the slow 3D two-radii inputs (fuzz/slow/sequence) can come near
+# the limit. Crashes, leaks, broken invariants and OOM still fail.
 set -u
 slow_mode=${FUZZ_SLOW:-fail}
 jobs=${FUZZ_JOBS:-$(nproc 2>/dev/null || echo 1)}
