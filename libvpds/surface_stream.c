@@ -89,6 +89,17 @@ static vpds_status piece_upper_bound(const vpdsi_surface_ctx *ctx, const vpdsi_s
     return VPDS_OK;
 }
 
+/* Parameters that rounding took past the triangle's edges (the largest gap often lies on a
+ * piece's edge) put back on them, so that no barycentric is negative: v <= fl(1 - u) makes
+ * (1 - u) - v >= 0 as the marks compute it. */
+static void clamp_to_triangle(double *uv)
+{
+    if (uv[0] < 0) uv[0] = 0;
+    if (uv[1] < 0) uv[1] = 0;
+    if (uv[0] > 1) uv[0] = 1;
+    if (uv[1] > 1 - uv[0]) uv[1] = 1 - uv[0];
+}
+
 /* A constant radius (ss->exact): the largest gap of the piece exactly, into *pt (g, r and where),
  * when the piece is not large beside its nearest sample (h <= EXACT_REACH times its distance):
  * only the samples within that distance + 2h of the centre can be nearest in it, and few are. *done = 0 when the
@@ -125,6 +136,7 @@ static vpds_status piece_exact(vpdsi_surface_stream *ss, const vpdsi_surface_ctx
     vpdsi_surface_gap_max(e1, e2, z, (int)ss->n_cand, ab);
     for (k = 0; k < 2; k++)
         pt->uv[k] = p->uv[0][k] + ab[0] * (p->uv[1][k] - p->uv[0][k]) + ab[1] * (p->uv[2][k] - p->uv[0][k]);
+    clamp_to_triangle(pt->uv);
     vpdsi_trimesh_point(ctx->mesh, p->tri, pt->uv, pt->x);
     /* g where the sample goes: the gap of its own coordinates */
     for (i = 0; i < ss->n_cand; i++) {
@@ -206,6 +218,13 @@ static vpds_status first_surface_sample(vpdsi_surface_stream *ss, const vpdsi_su
     return VPDS_OK;
 }
 
+/* Whether the stream checks a sizing's declared L at the centres it looks at (a callback or a
+ * grid; vertex radii and a constant need no check). */
+static int lipschitz_checked(const vpdsi_surface_ctx *ctx)
+{
+    return !ctx->mesh->vr && ctx->st->sizing.kind != VPDSI_SIZING_CONSTANT;
+}
+
 /* g at the piece's centroid (r there exact); a better point than *best replaces it. With a sizing
  * callback the bounds trust the declared L: it is checked against the nearest sample. */
 static vpds_status look_at_centre(const vpdsi_surface_ctx *ctx, const vpdsi_surface_heap_entry *p,
@@ -218,7 +237,7 @@ static vpds_status look_at_centre(const vpdsi_surface_ctx *ctx, const vpdsi_surf
     piece_centre(ctx->mesh, p, x, cuv, c);
     if ((e = vpdsi_trimesh_radius(ctx->mesh, ctx->st, p->tri, cuv, c, &r)) != VPDS_OK) return e;
     g = vpdsi_kd_min_ratio(&ctx->st->tree, &v, c, 0, r, (int)ctx->rule, &arg);
-    if (!ctx->mesh->vr && ctx->st->sizing.kind != VPDSI_SIZING_CONSTANT && arg >= 0) {
+    if (lipschitz_checked(ctx) && arg >= 0) {
         const double *xa = ctx->st->x + 3 * (size_t)arg;
         double d = sqrt((c[0] - xa[0]) * (c[0] - xa[0]) + (c[1] - xa[1]) * (c[1] - xa[1]) +
                         (c[2] - xa[2]) * (c[2] - xa[2]));
@@ -316,12 +335,18 @@ static vpds_status split_top(vpdsi_surface_stream *ss, const vpdsi_surface_ctx *
     n = ss->bisect ? split_two(ctx->mesh, &p, child) : split_four(&p, child);
     for (q = 0; q < n; q++) {
         child[q].level = p.level + 1;
-        if ((e = piece_upper_bound(ctx, &child[q], &child[q].ub)) != VPDS_OK ||
-            (e = look_at_centre(ctx, &child[q], best)) != VPDS_OK) {
+        if ((e = piece_upper_bound(ctx, &child[q], &child[q].ub)) != VPDS_OK) {
             *best = keep;
             return e;
         }
         if (child[q].ub > ub) child[q].ub = ub; /* the child lies in its parent */
+        /* from version 7 a centre that cannot beat the best point is not looked at (g there is
+         * below the child's bound), except where a sizing callback's L is checked there */
+        if (ss->bisect && child[q].ub <= best->g && !lipschitz_checked(ctx)) continue;
+        if ((e = look_at_centre(ctx, &child[q], best)) != VPDS_OK) {
+            *best = keep;
+            return e;
+        }
     }
     ss->heap[0] = child[0];
     heap_sift_down(ss->heap, ss->n_heap, 0);
@@ -383,7 +408,8 @@ vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx
         if ((e = reserve_heap(ss, ctx)) != VPDS_OK) return e;
         start_heap(ss, ctx->mesh);
     }
-    /* scales never rise: two pieces' exact gaps at one point may differ in the last bits */
+    /* scales never rise: two pieces' exact gaps at one point may differ in the last bits (only
+     * round-off: test_mesh checks each sample's gap against its t to 1e-12) */
     if (ss->bisect && ctx->st->n > 0 && ctx->st->t[ctx->st->n - 1] < t_max) t_max = ctx->st->t[ctx->st->n - 1];
     for (;;) {
         double ub = -1, t;

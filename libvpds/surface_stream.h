@@ -7,7 +7,9 @@
  * versions 3-6), or in two at the midpoint of its longest edge (7 on), so that a needle's pieces
  * get shorter without getting thinner. From version 7 with a constant radius a piece small beside
  * its nearest sample takes its largest gap exactly from the few samples near it, and the stream
- * inserts exact farthest points. The first sample is uniform by area. */
+ * inserts exact farthest points (except where a piece that can split no more has more than
+ * VPDSI_SURFACE_GAP_MAX_POINTS samples near: its centre at the tolerance, as for other radii).
+ * The first sample is uniform by area. */
 #ifndef VPDS_SURFACE_STREAM_H
 #define VPDS_SURFACE_STREAM_H
 #include "pieces.h"

@@ -849,6 +849,18 @@ static size_t uncovered_probes(const mesh_t *m, const double *vr, radius_fn rf, 
     return bad;
 }
 
+/* Every barycentric of every sample in [0, 1], summing to 1. */
+static int no_negative_barycentrics(const vpds_mesh *s)
+{
+    const double *b = vpds_mesh_barycentrics(s);
+    size_t i;
+    for (i = 0; i < vpds_mesh_count(s); i++)
+        if (!(b[3 * i] >= 0 && b[3 * i + 1] >= 0 && b[3 * i + 2] >= 0) ||
+            fabs(b[3 * i] + b[3 * i + 1] + b[3 * i + 2] - 1) > 1e-15)
+            return 0;
+    return 1;
+}
+
 /* The stream on a surface: n samples, t non-increasing, each prefix covered at its t and
  * conflict-free within the stream's tolerance (exactly with a constant radius), by brute force; determinism, STREAM_END consuming
  * nothing, a paused run refusing to stream, every allocation failing once. */
@@ -889,6 +901,23 @@ static void stream_case(const char *what, const mesh_t *m, const double *vr, rad
             for (q = 0; q < 3; q++) d2 += (xs[3 * i + q] - xs[3 * j + q]) * (xs[3 * i + q] - xs[3 * j + q]);
             conflicts += d2 < fr * fr;
         }
+    if (vr == NULL && rf == r_const) {
+        /* the exact farthest point: its gap is its t (the cap on scales only takes round-off) */
+        const double *xs = vpds_mesh_points(s), *ts = vpds_mesh_scales(s);
+        size_t above = 0;
+        for (j = 1; j < vpds_mesh_count(s); j++) {
+            double near2 = INFINITY;
+            for (i = 0; i < j; i++) {
+                double d2 = 0;
+                int q;
+                for (q = 0; q < 3; q++) d2 += (xs[3 * i + q] - xs[3 * j + q]) * (xs[3 * i + q] - xs[3 * j + q]);
+                if (d2 < near2) near2 = d2;
+            }
+            above += sqrt(near2) > ts[j] * radius * (1 + 1e-12);
+        }
+        CHECK_MSG(above == 0, "%s: %zu samples farther from the others than their t", what, above);
+    }
+    CHECK_MSG(no_negative_barycentrics(s), "%s: a negative barycentric", what);
     CHECK_MSG(bad_t == 0, "%s: %zu scales out of order", what, bad_t);
     CHECK_MSG(conflicts == 0, "%s: %zu pairs in conflict", what, conflicts);
     CHECK_MSG(checked > 3 && uncovered == 0, "%s: %zu probes uncovered over %zu prefixes", what, uncovered, checked);
@@ -1208,6 +1237,25 @@ static void test_stream_needles(void)
     add_t(&m, 0, 5, 1);
     add_t(&m, 0, 6, 7);
     stream_case("stream, needles", &m, NULL, r_const, VPDS_RULE_SMALLER, 0.03, quick ? 60 : 150);
+    {
+        /* the exact farthest point often lies on a piece's edge: its parameters, rounded past it,
+         * are put back on the triangle (the unit square as two triangles, 3000 events: 15
+         * negative barycentrics before) */
+        mesh_t sq = {0};
+        vpds_mesh_desc d;
+        vpds_mesh *s = NULL;
+        double x[3], t;
+        int k, events = quick ? 1000 : 3000;
+        square_part(&sq, 0, 1, 1, 1, 0, 0, 1);
+        d = desc_for(&sq);
+        d.radius = 0.01;
+        if (vpds_mesh_create(&d, &s) == VPDS_OK) {
+            for (k = 0; k < events; k++) CHECK(vpds_mesh_next(s, 0, x, &t) == VPDS_OK);
+            CHECK_MSG(no_negative_barycentrics(s), "the square's stream: a negative barycentric");
+            vpds_mesh_destroy(s);
+        }
+        mesh_free(&sq);
+    }
     if (!quick) { /* version 6 takes 77 MB here: not under valgrind */
         p6 = stream_peak(&m, 0.03, 6, 25);
         p7 = stream_peak(&m, 0.03, 7, 25);
