@@ -315,8 +315,7 @@ vpds_status vpds_mesh_create(const vpds_mesh_desc *d, vpds_mesh **out)
     s->progress_user = d->progress_user;
     vpdsi_rng_seed(&s->rng, d->seed);
     vpdsi_surface_init(&s->surface);
-    vpdsi_surface_stream_init(&s->stream, d->algorithm_version ? d->algorithm_version : VPDS_ALGORITHM_VERSION,
-                              !s->view.vr && s->store.sizing.kind == VPDSI_SIZING_CONSTANT);
+    vpdsi_surface_stream_init(&s->stream, d->algorithm_version ? d->algorithm_version : VPDS_ALGORITHM_VERSION);
     s->magic = VPDSI_MESH_MAGIC;
     *out = s;
     return VPDS_OK;

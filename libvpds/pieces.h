@@ -78,8 +78,9 @@ void vpdsi_trimesh_point(const vpdsi_trimesh *mesh, uint32_t k, const double *uv
  * store's sizing. */
 vpds_status vpdsi_trimesh_radius(const vpdsi_trimesh *mesh, vpdsi_store *st, uint32_t k,
                                  const double *uv, const double *x, double *r);
-/* Bounds of r over a piece of live triangle tri (corners uv, x): exact at the corners for vertex radii (r is linear there), the
- * constant, or r at the centroid widened by L times the farthest corner. */
+/* Bounds of r over a piece of live triangle tri (corners uv, x): exact at the corners for
+ * vertex radii (r is linear there), the constant, or r at the centroid widened by L times the
+ * farthest corner. */
 vpds_status vpdsi_piece_bounds(const vpdsi_trimesh *mesh, vpdsi_store *st, uint32_t tri,
                                double uv[3][2], double x[3][3], double *r_lo, double *r_hi);
 #endif

@@ -109,15 +109,13 @@ static size_t rmax_lattice(int d, int capped, int *per, int *hashed)
     size_t n = 1;
     int k;
     *per = 2;
+    /* the first pass always runs (3 * 1 <= 4096): n = per^d, at most 3^16 */
     while (*per < 64 && n * (size_t)(*per + 1) <= RMAX_PROBES) {
         (*per)++;
         for (n = 1, k = 0; k < d; k++) n *= (size_t)*per;
     }
-    for (n = 1, k = 0; k < d && n <= RMAX_PROBES; k++) n *= (size_t)*per;
     *hashed = capped && n > RMAX_PROBES;
-    if (*hashed) return RMAX_PROBES;
-    for (n = 1, k = 0; k < d; k++) n *= (size_t)*per;
-    return n;
+    return *hashed ? RMAX_PROBES : n;
 }
 
 /* r_max only sizes the base cells of the kd-tree path (never a correctness bound there), so

@@ -13,11 +13,10 @@
  * and 0.96 s for 20,000 on the golden terrain at r = 0.004 */
 #define EXACT_REACH 1.5
 
-void vpdsi_surface_stream_init(vpdsi_surface_stream *ss, uint32_t algorithm_version, int constant_radius)
+void vpdsi_surface_stream_init(vpdsi_surface_stream *ss, uint32_t algorithm_version)
 {
     memset(ss, 0, sizeof *ss);
     ss->bisect = algorithm_version >= 7;
-    ss->exact = ss->bisect && constant_radius;
 }
 
 void vpdsi_surface_stream_release(vpdsi_surface_stream *ss, vpdsi_mem *m)
@@ -100,11 +99,24 @@ static void clamp_to_triangle(double *uv)
     if (uv[1] > 1 - uv[0]) uv[1] = 1 - uv[0];
 }
 
-/* A constant radius (ss->exact): the largest gap of the piece exactly, into *pt (g, r and where),
- * when the piece is not large beside its nearest sample (h <= EXACT_REACH times its distance):
- * only the samples within that distance + 2h of the centre can be nearest in it, and few are. *done = 0 when the
- * piece is larger or too many samples are near (it splits instead); *bound then bounds g over
- * it (piece_upper_bound's, from the same nearest-sample query). */
+/* Whether the stream checks a sizing's declared L at the centres it looks at (a callback or a
+ * grid; vertex radii and a constant need no check). */
+static int lipschitz_checked(const vpdsi_surface_ctx *ctx)
+{
+    return !ctx->mesh->vr && ctx->st->sizing.kind != VPDSI_SIZING_CONSTANT;
+}
+
+/* Whether pieces take their exact gap (a constant radius, version 7 on). */
+static int exact_search(const vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ctx)
+{
+    return ss->bisect && !ctx->mesh->vr && ctx->st->sizing.kind == VPDSI_SIZING_CONSTANT;
+}
+
+/* A constant radius (exact_search): the largest gap of the piece exactly, into *pt (g, r and
+ * where), when the piece is not large beside its nearest sample (h <= EXACT_REACH times its
+ * distance): only the samples within that distance + 2h of the centre can be nearest in it, and
+ * few are. *done = 0 when the piece is larger or too many samples are near (it splits instead);
+ * *bound then bounds g over it (piece_upper_bound's, from the same nearest-sample query). */
 static vpds_status piece_exact(vpdsi_surface_stream *ss, const vpdsi_surface_ctx *ctx,
                                const vpdsi_surface_heap_entry *p, int *done, vpdsi_surface_best *pt,
                                double *bound)
@@ -218,12 +230,6 @@ static vpds_status first_surface_sample(vpdsi_surface_stream *ss, const vpdsi_su
     return VPDS_OK;
 }
 
-/* Whether the stream checks a sizing's declared L at the centres it looks at (a callback or a
- * grid; vertex radii and a constant need no check). */
-static int lipschitz_checked(const vpdsi_surface_ctx *ctx)
-{
-    return !ctx->mesh->vr && ctx->st->sizing.kind != VPDSI_SIZING_CONSTANT;
-}
 
 /* g at the piece's centroid (r there exact); a better point than *best replaces it. With a sizing
  * callback the bounds trust the declared L: it is checked against the nearest sample. */
@@ -399,6 +405,7 @@ vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx
                                double t_min, double t_max, double *x_out, double *t_out)
 {
     vpdsi_surface_best *best = &ss->best, exact_pt;
+    int exact_mode = exact_search(ss, ctx);
     vpds_status e;
     /* a run may have filed its samples in another index: the bounds read the kd-tree */
     if ((e = vpdsi_store_sync_tree(ctx->st)) != VPDS_OK) return e;
@@ -414,7 +421,7 @@ vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx
     for (;;) {
         double ub = -1, t;
         int exact = 0;
-        if (ss->exact && (e = piece_exact(ss, ctx, &ss->heap[0], &exact, &exact_pt, &ub)) != VPDS_OK) return e;
+        if (exact_mode && (e = piece_exact(ss, ctx, &ss->heap[0], &exact, &exact_pt, &ub)) != VPDS_OK) return e;
         if (exact) {
             /* its largest gap, below the bound it had if a sample came near since */
             if (exact_pt.g < ss->heap[0].ub * (1 - 1e-12)) {
@@ -445,7 +452,7 @@ vpds_status vpdsi_surface_next(vpdsi_surface_stream *ss, const vpdsi_surface_ctx
         /* ub bounds g over the whole surface: a point within the tolerance of it is the next
          * (with the exact search, only where a piece can split no more) */
         if ((e = look_at_centre(ctx, &ss->heap[0], best)) != VPDS_OK) return e;
-        if ((!ss->exact && best->g >= ub * (1 - VPDS_STREAM_TOLERANCE)) || !may_split(ss, ctx, &ss->heap[0])) {
+        if ((!exact_mode && best->g >= ub * (1 - VPDS_STREAM_TOLERANCE)) || !may_split(ss, ctx, &ss->heap[0])) {
             if ((e = emit(ctx, best, t, x_out, t_out)) != VPDS_OK) return e;
             best->g = -1; /* new sample: every g seen is stale */
             return VPDS_OK;

@@ -32,8 +32,6 @@ typedef struct vpdsi_surface_best {
 
 typedef struct vpdsi_surface_stream {
     int bisect;              /* split in two at the longest edge (version 7 on), else in four */
-    int exact;               /* a constant radius from version 7: small pieces find their
-                                largest gap exactly (surface_gap.h), not to the tolerance */
     int started;             /* the first sample is placed */
     vpdsi_surface_best best; /* kept across calls that fail or end: the samples are the same */
     vpdsi_surface_heap_entry *heap;
@@ -42,8 +40,8 @@ typedef struct vpdsi_surface_stream {
     size_t n_cand, cap_cand;
 } vpdsi_surface_stream;
 
-/* An empty stream for the mesh's algorithm version; constant_radius: r is one value everywhere. */
-void vpdsi_surface_stream_init(vpdsi_surface_stream *ss, uint32_t algorithm_version, int constant_radius);
+/* An empty stream for the mesh's algorithm version. */
+void vpdsi_surface_stream_init(vpdsi_surface_stream *ss, uint32_t algorithm_version);
 void vpdsi_surface_stream_release(vpdsi_surface_stream *ss, vpdsi_mem *m);
 /* The next sample into x_out (3 doubles), its scale into *t_out: VPDS_OK, or VPDS_STREAM_END when
  * its scale would be at or below t_min (nothing consumed), or an error (nothing consumed). The
