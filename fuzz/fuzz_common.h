@@ -66,17 +66,56 @@ static void check_status(vpds_status st)
     FUZZ_ASSERT(strncmp(vpds_status_string(st), "VPDS_", 5) == 0, "status %d has no name", (int)st);
 }
 
+/* Samples i and j < i do not conflict (Eq. 10, with the radii the library recorded and i's
+ * scale). */
+static void check_pair(const vpds_sampler *s, size_t i, size_t j, const double *lo,
+                       const double *hi, vpds_rule rule, double inhibition, const int *periodic)
+{
+    int d = vpds_dim(s), k;
+    const double *x = vpds_points(s), *r = vpds_radii(s), *t = vpds_scales(s);
+    double d2 = 0, f = t[i] * inhibition * rule_f(rule, r[j], r[i]);
+    for (k = 0; k < d; k++) {
+        double e = fabs(x[i * d + k] - x[j * d + k]), P = hi[k] - lo[k];
+        if (periodic && periodic[k] && e > 0.5 * P) e = P - e; /* toroidal */
+        d2 += e * e;
+    }
+    /* a stream's samples keep off by t * (1 - VPDS_STREAM_TOLERANCE) */
+    f *= 1 - VPDS_STREAM_TOLERANCE;
+    FUZZ_ASSERT(d2 >= f * f, "sample %zu conflicts with %zu (%g < %g)", i, j, sqrt(d2), f);
+}
+
+static const double *sort_key;
+static int by_first_coordinate(const void *a, const void *b)
+{
+    double u = sort_key[*(const size_t *)a], v = sort_key[*(const size_t *)b];
+    return u < v ? -1 : u > v;
+}
+
+/* The samples in sorted order whose first coordinate lies within w of sample `at`'s (ranks
+ * [*a, *b]; x0 holds the sorted first coordinates, rank the rank of each sample). */
+static void window(const double *x0, size_t n, size_t rank, double w, size_t *a, size_t *b)
+{
+    *a = *b = rank;
+    while (*a > 0 && x0[*a - 1] > x0[rank] - w) --*a;
+    while (*b + 1 < n && x0[*b + 1] < x0[rank] + w) ++*b;
+}
+
 /* Samples `from` on: finite, r > 0, inside the box unless fixed, and none conflicts with one
- * before it (Eq. 10, with the radii the library recorded and each sample's scale); a harness
- * that checked the earlier ones passes from = how many it checked. */
+ * before it (check_pair); a harness that checked the earlier ones passes from = how many it
+ * checked. Every rule's f is at most max(r_i, r_j), so a conflict needs |x0_i - x0_j| < t_i *
+ * inhibition * r_i or < t_i * inhibition * r_j: on an open first axis each new sample i is
+ * checked against the earlier ones within twice the first of it along x0, and each sample j
+ * against the new ones within twice the second (with the largest new t), not against all: the
+ * fuzzer's slowest inputs hold thousands of samples. */
 static void check_samples_since(const vpds_sampler *s, size_t from, const double *lo,
                                 const double *hi, vpds_rule rule, double inhibition,
                                 const int *periodic)
 {
-    size_t n = vpds_count(s), i, j;
+    size_t n = vpds_count(s), i, j, a, b, *order = NULL, *rank = NULL;
     int d = vpds_dim(s), k;
     const double *x = vpds_points(s), *r = vpds_radii(s), *t = vpds_scales(s);
     const uint8_t *fl = vpds_flags(s);
+    double t_max = 0, *x0 = NULL;
     if (rule == VPDS_RULE_DEFAULT) rule = VPDS_RULE_SMALLER;
     for (i = from; i < n; i++) {
         FUZZ_ASSERT(isfinite(r[i]) && r[i] > 0, "r[%zu] = %g", i, r[i]);
@@ -85,22 +124,45 @@ static void check_samples_since(const vpds_sampler *s, size_t from, const double
             if (!(fl[i] & VPDS_FLAG_FIXED))
                 FUZZ_ASSERT(x[i * d + k] >= lo[k] && x[i * d + k] <= hi[k], "x[%zu] outside the box", i);
         }
-        if (fl[i] & VPDS_FLAG_FIXED) {
-            FUZZ_ASSERT(isinf(t[i]), "fixed point %zu has t = %g", i, t[i]);
-            continue;
-        }
-        for (j = 0; j < i; j++) {
-            double d2 = 0, f = t[i] * inhibition * rule_f(rule, r[j], r[i]);
-            for (k = 0; k < d; k++) {
-                double e = fabs(x[i * d + k] - x[j * d + k]), P = hi[k] - lo[k];
-                if (periodic && periodic[k] && e > 0.5 * P) e = P - e; /* toroidal */
-                d2 += e * e;
-            }
-            /* a stream's samples keep off by t * (1 - VPDS_STREAM_TOLERANCE) */
-            f *= 1 - VPDS_STREAM_TOLERANCE;
-            FUZZ_ASSERT(d2 >= f * f, "sample %zu conflicts with %zu (%g < %g)", i, j, sqrt(d2), f);
+        if (fl[i] & VPDS_FLAG_FIXED) FUZZ_ASSERT(isinf(t[i]), "fixed point %zu has t = %g", i, t[i]);
+        else FUZZ_ASSERT(t[i] >= 0, "t[%zu] = %g", i, t[i]); /* inf: a stream's first sample */
+        if (!(fl[i] & VPDS_FLAG_FIXED) && t[i] > t_max) t_max = t[i];
+    }
+    if (n <= 64 || (periodic && periodic[0])) { /* every pair */
+        for (i = from; i < n; i++)
+            for (j = 0; j < i && !(fl[i] & VPDS_FLAG_FIXED); j++)
+                check_pair(s, i, j, lo, hi, rule, inhibition, periodic);
+        return;
+    }
+    order = (size_t *)malloc(n * sizeof *order);
+    x0 = (double *)malloc(n * sizeof *x0);
+    rank = (size_t *)malloc(n * sizeof *rank);
+    FUZZ_ASSERT(order && x0 && rank, "out of memory checking %zu samples", n);
+    for (i = 0; i < n; i++) {
+        order[i] = i;
+        x0[i] = x[i * d];
+    }
+    sort_key = x0;
+    qsort(order, n, sizeof *order, by_first_coordinate);
+    for (i = 0; i < n; i++) x0[i] = x[order[i] * d]; /* now sorted */
+    for (i = 0; i < n; i++) rank[order[i]] = i;
+    for (i = from; i < n; i++) { /* within t_i * inhibition * r_i of i */
+        if (fl[i] & VPDS_FLAG_FIXED) continue;
+        window(x0, n, rank[i], 2 * t[i] * inhibition * r[i], &a, &b);
+        for (; a <= b; a++)
+            if (order[a] < i) check_pair(s, i, order[a], lo, hi, rule, inhibition, periodic);
+    }
+    for (j = 0; j < n; j++) { /* within t_max * inhibition * r_j of j */
+        window(x0, n, rank[j], 2 * t_max * inhibition * r[j], &a, &b);
+        for (; a <= b; a++) {
+            i = order[a];
+            if (i > j && i >= from && !(fl[i] & VPDS_FLAG_FIXED))
+                check_pair(s, i, j, lo, hi, rule, inhibition, periodic);
         }
     }
+    free(order);
+    free(x0);
+    free(rank);
 }
 
 /* All the samples so far, as check_samples_since. */
