@@ -60,8 +60,12 @@ extern "C" {
  * the few samples near a small piece) instead of one within the tolerance (other points for
  * vpds_mesh_next), and a sizing callback's largest radius is estimated from at most 4096
  * probes in any dimension, not 3^d (other points for a sizing callback in 8 dimensions and up;
- * every other box gives the points of version 6). */
-#define VPDS_ALGORITHM_VERSION 7
+ * every other box gives the points of version 6). 8: the coverage search of two radii and of a
+ * domain, before splitting a box whose nearest point is covered, tests the box's corner
+ * farthest from the sample that covers it, so that it stops at an uncovered wedge at the edge
+ * of a cell instead of splitting down to its precision limit (the points of version 7 except
+ * where the search's box budget or precision decided; fewer boxes and sizing calls). */
+#define VPDS_ALGORITHM_VERSION 8
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 16
 /* Relative tolerance eps of the continuous stream (vpds_next): each t it reports is an upper

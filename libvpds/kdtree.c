@@ -434,16 +434,17 @@ size_t vpdsi_kd_list_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, co
     return count;
 }
 
-int vpdsi_kd_list_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *cand,
-                           size_t n, const double *y, double ry, int rule, double scale)
+int32_t vpdsi_kd_list_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
+                               const int32_t *cand, size_t n, const double *y, double ry, int rule,
+                               double scale)
 {
     size_t j;
     for (j = 0; j < n; j++) {
         int32_t i = cand[j];
         double f = conflict_reach(s, i, ry, rule, scale);
-        if (dist2(y, s->x + (size_t)i * (size_t)t->dim, t->dim) < f * f) return 1;
+        if (dist2(y, s->x + (size_t)i * (size_t)t->dim, t->dim) < f * f) return i;
     }
-    return 0;
+    return -1;
 }
 
 int vpdsi_kd_list_box_covered(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,

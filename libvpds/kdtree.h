@@ -99,9 +99,11 @@ size_t vpdsi_kd_filter_near(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, co
 size_t vpdsi_kd_list_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *from,
                             size_t n, const double *lo, const double *hi, double r_hi, int rule,
                             double scale, int split, int32_t *out);
-/* Whether a candidate conflicts with y (vpdsi_kd_conflict without the Lipschitz check). */
-int vpdsi_kd_list_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *cand,
-                           size_t n, const double *y, double ry, int rule, double scale);
+/* The first candidate that conflicts with y, or -1 (vpdsi_kd_conflict without the Lipschitz
+ * check). */
+int32_t vpdsi_kd_list_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
+                               const int32_t *cand, size_t n, const double *y, double ry, int rule,
+                               double scale);
 /* vpdsi_kd_gather (no split) at r_hi followed by vpdsi_kd_box_covered at r_lo, on candidates. */
 int vpdsi_kd_list_box_covered(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
                               const int32_t *cand, size_t n, const double *lo, const double *hi,

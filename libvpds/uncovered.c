@@ -46,6 +46,9 @@ typedef struct {
                          error, so that a retried dart takes the same boxes as the first try */
     int sub_depth;
     int far_first;    /* version 6: a box's children from the farthest from the anchor on */
+    int far_corner;   /* version 8: a box that splits tries its corner farthest from the sample
+                         that covers its nearest point */
+    int32_t cover;    /* that sample (-1: p was not tested) */
     vpdsi_kd_samples view, uview;
     bb_lists lv[UNCOVERED_DEPTH + 1];
     /* the box being examined: kept here, not in the helpers' frames, which then cost nothing
@@ -120,14 +123,15 @@ static void sample_list(bb_search *q, int depth, const double *lo, const double 
     me->r_bound = rb;
 }
 
-/* Whether a sample covers p at t * coverage (vpdsi_kd_conflict, from the list when complete). */
-static int p_covered(bb_search *q, int depth, const double *p, double rp)
+/* A sample that covers p at t * coverage, or -1 (vpdsi_kd_conflict, from the list when
+ * complete). */
+static int32_t p_cover(bb_search *q, int depth, const double *p, double rp)
 {
     if (q->lv[depth].s_ok)
-        return q->lv[depth].s_n > 0 &&
-               vpdsi_kd_list_conflict(&q->st->tree, &q->view, q->u->lists + slot(depth, 1),
-                                      q->lv[depth].s_n, p, rp, (int)q->pb->rule, q->scale);
-    return vpdsi_kd_conflict(&q->st->tree, &q->view, p, rp, (int)q->pb->rule, q->scale, -1.0, &q->w) != -1;
+        return q->lv[depth].s_n == 0 ? -1
+               : vpdsi_kd_list_conflict(&q->st->tree, &q->view, q->u->lists + slot(depth, 1),
+                                        q->lv[depth].s_n, p, rp, (int)q->pb->rule, q->scale);
+    return vpdsi_kd_conflict(&q->st->tree, &q->view, p, rp, (int)q->pb->rule, q->scale, -1.0, &q->w);
 }
 
 /* Whether one sample covers the whole box, r_lo <= r <= r_hi over it (gather, then the test). */
@@ -152,6 +156,63 @@ static vpds_status search_box_covered(bb_search *q, int depth, const double *lo,
                                                 q->u->n_lists - off, lo, hi, r_lo, (int)q->pb->rule,
                                                 q->scale);
     return VPDS_OK;
+}
+
+/* p, uncovered in the region and the domain at r(p) = rp: the search's witness. */
+static vpds_status take_witness(bb_search *q, const double *p, double rp, int *verdict)
+{
+    int d = q->pb->dim;
+    vpds_status st;
+    q->phi = 0;
+    if (q->dom->fn && (st = vpdsi_domain_at(q->dom, q->st, p, &q->phi)) != VPDS_OK) return st;
+    if (q->phi > 0) return VPDS_OK;
+    *verdict = 1;
+    q->found_point = 1;
+    if (q->witness) {
+        memcpy(q->witness, p, (size_t)d * sizeof(double));
+        q->witness[d] = rp;
+    }
+    return VPDS_OK;
+}
+
+/* Version 8: a box about to split tries a second point, its corner farthest from the sample
+ * that covers p. Where that sample's coverage sphere crosses the anchor's boundary, the
+ * uncovered part of the anchor is a thin wedge: p stayed covered at every depth and the search
+ * dived to the precision limit (40 levels) before answering. f grows with r(u) under every
+ * rule, so the corner is in the region if it is at the box's lowest r, and covered if it is
+ * at that r: the sizing is read only when that does not decide. */
+static vpds_status far_corner(bb_search *q, int depth, const double *lo, const double *hi,
+                              double r_lo, int *verdict)
+{
+    int d = q->pb->dim, k;
+    const double *x = q->view.x + (size_t)q->cover * (size_t)d;
+    double y[VPDS_MAX_DIM], d2 = 0, ry;
+    vpds_status st;
+    for (k = 0; k < d; k++) {
+        double P = q->pb->period[k], e = x[k] - 0.5 * (lo[k] + hi[k]);
+        if (P > 0) e -= P * floor(e / P + 0.5); /* the image of x nearest the box */
+        y[k] = e > 0 ? lo[k] : hi[k];
+        if (q->point) {
+            d2 += (y[k] - q->alo[k]) * (y[k] - q->alo[k]);
+        } else {
+            double g = y[k] < q->alo[k] ? q->alo[k] - y[k] : y[k] > q->ahi[k] ? y[k] - q->ahi[k] : 0;
+            d2 += g * g;
+        }
+    }
+    if (q->point) {
+        double f = q->scale * vpdsi_rule_f(q->pb->rule, q->r_anchor, r_lo);
+        if (!(r_lo > 0) || d2 > f * f) return VPDS_OK;
+    } else if (d2 > q->reach * q->reach) {
+        return VPDS_OK;
+    }
+    if (q->st->sizing.kind == VPDSI_SIZING_CONSTANT) {
+        ry = q->st->sizing.radius;
+    } else {
+        if (p_cover(q, depth, y, r_lo) >= 0) return VPDS_OK; /* covered at any r it may have */
+        if ((st = vpdsi_store_radius_at(q->st, y, &ry)) != VPDS_OK) return st;
+    }
+    if (p_cover(q, depth, y, ry) >= 0) return VPDS_OK;
+    return take_witness(q, y, ry, verdict);
 }
 
 /* One box at `depth`: *verdict 0 when it is dropped, 1 when it answers "uncovered" (a witness,
@@ -216,19 +277,10 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
         in_region = d2 <= q->reach * q->reach;
     }
     sample_list(q, depth, lo, hi, q->rp, r_hi, diag);
-    if (in_region && !p_covered(q, depth, p, q->rp)) {
+    q->cover = -1;
+    if (in_region && (q->cover = p_cover(q, depth, p, q->rp)) < 0) {
         /* p is uncovered: no sample within t*coverage*f of it; a witness if in the domain */
-        q->phi = 0;
-        if (q->dom->fn && (st = vpdsi_domain_at(q->dom, q->st, p, &q->phi)) != VPDS_OK) return st;
-        if (q->phi <= 0) {
-            *verdict = 1;
-            q->found_point = 1;
-            if (q->witness) {
-                memcpy(q->witness, p, (size_t)d * sizeof(double));
-                q->witness[d] = q->rp;
-            }
-            return VPDS_OK;
-        }
+        if ((st = take_witness(q, p, q->rp, verdict)) != VPDS_OK || *verdict) return st;
     }
     if ((st = search_box_covered(q, depth, lo, hi, r_lo, r_hi, verdict)) != VPDS_OK) return st;
     if (*verdict) { /* inside one coverage disk */
@@ -237,7 +289,12 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
         return VPDS_OK;
     }
     /* unresolved at the precision: count it as uncovered */
-    *verdict = depth >= UNCOVERED_DEPTH || !(diag > 1e-12 * q->reach) ? 1 : 2;
+    if (depth >= UNCOVERED_DEPTH || !(diag > 1e-12 * q->reach)) {
+        *verdict = 1;
+        return VPDS_OK;
+    }
+    if (q->far_corner && q->cover >= 0 && (st = far_corner(q, depth, lo, hi, r_lo, verdict)) != VPDS_OK) return st;
+    if (!*verdict) *verdict = 2;
     return VPDS_OK;
 }
 
@@ -394,6 +451,7 @@ static vpds_status prepare(bb_search *q, vpdsi_uncovered *u, const vpdsi_ctx *ct
     q->point = memcmp(alo, ahi, (size_t)d * sizeof(double)) == 0;
     q->exact_region = pb->algorithm >= 2;
     q->far_first = pb->algorithm >= 6;
+    q->far_corner = pb->algorithm >= 8;
     q->budget = VPDSI_UNCOVERED_BUDGET;
     /* largest reach of the region: r(u) <= r_anchor + L |u - a| and |u - a| <= scale r(u) */
     q->reach = vpdsi_rule_reach(pb->rule, q->scale, q->L, r_anchor);

@@ -221,9 +221,10 @@ def test_algorithm_version_pins_the_points():
     those of version 2); version 4 made the search learn, with the points of version 3;
     version 5 made the stream of one radius exact (its runs are version 4's); version 6 made the
     two-radii search skip the sub-boxes it showed covered (the points of 5 here); version 7
-    changed only the stream on meshes (boxes give the points of 6); a version the library does
-    not have is refused."""
-    assert vpds.ALGORITHM_VERSION == 7
+    changed only the stream on meshes (boxes give the points of 6); version 8 made the coverage
+    search test a splitting box's far corner (the points of 7); a version the library does not
+    have is refused."""
+    assert vpds.ALGORITHM_VERSION == 8
 
     def fill(version, inhibition):
         engine = vpds.PoissonDisk(2, sizing=lambda x: 0.04 + 0.04 * x[:, 0], lipschitz=0.04,
@@ -236,6 +237,7 @@ def test_algorithm_version_pins_the_points():
     assert np.array_equal(current, fill(5, 0.6))
     assert np.array_equal(current, fill(6, 0.6))
     assert np.array_equal(current, fill(7, 0.6))
+    assert np.array_equal(current, fill(8, 0.6))
     assert np.array_equal(current, v3)
     assert np.array_equal(v2, v3)
     assert not np.array_equal(v1, v2)
@@ -249,7 +251,8 @@ def test_algorithm_version_pins_the_points():
     assert np.array_equal(stream(None), stream(5))
     assert np.array_equal(stream(6), stream(5))
     assert np.array_equal(stream(7), stream(5))
+    assert np.array_equal(stream(8), stream(5))
     assert not np.array_equal(stream(5), stream(4))
-    for bad in (8, -1, 1.5, True):
-        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.7"):
+    for bad in (9, -1, 1.5, True):
+        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.8"):
             vpds.PoissonDisk(2, algorithm_version=bad)
