@@ -64,7 +64,11 @@ extern "C" {
  * domain, before splitting a box whose nearest point is covered, tests the box's corner
  * farthest from the sample that covers it, so that it stops at an uncovered wedge at the edge
  * of a cell instead of splitting down to its precision limit (the points of version 7 except
- * where the search's box budget or precision decided; fewer boxes and sizing calls). */
+ * where the search's box budget or precision decided; fewer boxes and sizing calls), and the
+ * stream's search to the tolerance (a variable radius, a domain) finds the nearest samples of a
+ * split's children in a list its parent's split made, filtered, not in the kd-tree (the same
+ * minimum; the first of equally near samples may differ: the points of version 7 on every
+ * golden configuration). */
 #define VPDS_ALGORITHM_VERSION 8
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 16

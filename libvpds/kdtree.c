@@ -365,6 +365,19 @@ static double interval_gap(double a, double b, double lo, double hi, double P)
     return best;
 }
 
+/* Squared gap between node n's bounding box and the box [lo, hi], on the tree's torus. */
+static double node_gap2(const vpdsi_kdtree *t, int32_t n, const double *lo, const double *hi)
+{
+    const double *blo = BOX_LO(t, n), *bhi = BOX_HI(t, n);
+    double gap2 = 0;
+    int k;
+    for (k = 0; k < t->dim; k++) {
+        double g = interval_gap(blo[k], bhi[k], lo[k], hi[k], t->period[k]);
+        gap2 += g * g;
+    }
+    return gap2;
+}
+
 /* How far from the box a sample of radius r may lie and still matter (see kdtree.h). */
 static double near_limit(double r, double r_bound, double scale, double slack)
 {
@@ -382,20 +395,15 @@ int vpdsi_kd_near_box(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const do
                       vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap)
 {
     int32_t stack[STACK_MAX];
-    int top = 0, d = t->dim, k;
+    int top = 0;
     size_t end = *count + limit;
     if (t->n_nodes == 0) return 0;
     stack[top++] = 0;
     while (top > 0) {
         int32_t n = stack[--top];
         const vpdsi_kd_node *nd = &t->nodes[n];
-        const double *blo = BOX_LO(t, n), *bhi = BOX_HI(t, n);
-        double lim = near_limit(nd->rmax, r_bound, scale, slack), gap2 = 0;
-        for (k = 0; k < d; k++) {
-            double g = interval_gap(blo[k], bhi[k], lo[k], hi[k], t->period[k]);
-            gap2 += g * g;
-        }
-        if (gap2 > lim * lim) continue;
+        double lim = near_limit(nd->rmax, r_bound, scale, slack);
+        if (node_gap2(t, n, lo, hi) > lim * lim) continue;
         if (nd->left < 0) {
             int32_t i;
             for (i = nd->head; i >= 0; i = t->next[i]) {
@@ -463,13 +471,84 @@ int vpdsi_kd_list_box_covered(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
 
 double vpdsi_kd_list_min_ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
                                const int32_t *cand, size_t n, const double *y, double slack,
-                               double ry, int rule)
+                               double ry, int rule, int32_t *arg)
 {
     double best = INFINITY;
     size_t j;
+    if (arg) *arg = -1;
     for (j = 0; j < n; j++) {
         double q = ratio(t, s, cand[j], y, slack, ry, rule);
-        if (q < best) best = q;
+        if (q < best) {
+            best = q;
+            if (arg) *arg = cand[j];
+        }
     }
     return best;
+}
+
+/* A sample's ratio over the box, from below (nearest point, largest f) and above. */
+static void ratio_bounds(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i,
+                         const double *lo, const double *hi, double r_lo, double r_hi, int rule,
+                         double *lb, double *ub)
+{
+    const double *x = s->x + (size_t)i * (size_t)t->dim;
+    double f_hi = vpdsi_rule_f((vpds_rule)rule, s->r[i], r_hi);
+    double f_lo = vpdsi_rule_f((vpds_rule)rule, s->r[i], r_lo);
+    *lb = f_hi > 0 ? sqrt(vpdsi_box_mindist2(t, x, lo, hi)) / f_hi : 0;
+    *ub = f_lo > 0 ? sqrt(vpdsi_box_maxdist2(t, x, lo, hi)) / f_lo : INFINITY;
+}
+
+size_t vpdsi_kd_list_ratio_candidates(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
+                                      const int32_t *from, size_t n, const double *lo,
+                                      const double *hi, double r_lo, double r_hi, int rule,
+                                      int32_t *out)
+{
+    double best_ub = INFINITY, lb, ub;
+    size_t j, count = 0;
+    for (j = 0; j < n; j++) {
+        ratio_bounds(t, s, from[j], lo, hi, r_lo, r_hi, rule, &lb, &ub);
+        if (ub < best_ub) best_ub = ub;
+    }
+    for (j = 0; j < n; j++) {
+        ratio_bounds(t, s, from[j], lo, hi, r_lo, r_hi, rule, &lb, &ub);
+        if (lb <= best_ub * (1 + 1e-9)) out[count++] = from[j];
+    }
+    return count;
+}
+
+int vpdsi_kd_ratio_candidates(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *lo,
+                              const double *hi, double r_lo, double r_hi, int rule, vpdsi_mem *m,
+                              int32_t **out, size_t *count, size_t *cap)
+{
+    int32_t stack[STACK_MAX];
+    int top = 0;
+    size_t first = *count, j, kept;
+    double best_ub = INFINITY, lb, ub;
+    if (t->n_nodes == 0) return 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        int32_t n = stack[--top];
+        const vpdsi_kd_node *nd = &t->nodes[n];
+        double f = vpdsi_rule_f((vpds_rule)rule, nd->rmax, r_hi);
+        /* f is monotone in r(x): no sample of the node has a smaller lower bound */
+        if (f > 0 && sqrt(node_gap2(t, n, lo, hi)) / f > best_ub * (1 + 1e-9)) continue;
+        if (nd->left < 0) {
+            int32_t i;
+            for (i = nd->head; i >= 0; i = t->next[i]) {
+                ratio_bounds(t, s, i, lo, hi, r_lo, r_hi, rule, &lb, &ub);
+                if (ub < best_ub) best_ub = ub;
+                if (lb <= best_ub * (1 + 1e-9) && push_index(m, out, count, cap, i)) return -1;
+            }
+        } else {
+            int near = 0.5 * (lo[nd->axis] + hi[nd->axis]) < nd->split;
+            stack[top++] = near ? nd->right : nd->left;
+            stack[top++] = near ? nd->left : nd->right;
+        }
+    }
+    for (j = kept = first; j < *count; j++) { /* against the final bound, in order */
+        ratio_bounds(t, s, (*out)[j], lo, hi, r_lo, r_hi, rule, &lb, &ub);
+        if (lb <= best_ub * (1 + 1e-9)) (*out)[kept++] = (*out)[j];
+    }
+    *count = kept;
+    return 0;
 }

@@ -108,10 +108,24 @@ int32_t vpdsi_kd_list_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
 int vpdsi_kd_list_box_covered(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
                               const int32_t *cand, size_t n, const double *lo, const double *hi,
                               double r_hi, double r_lo, int rule, double scale);
-/* vpdsi_kd_min_ratio over candidates (+INFINITY: none). */
+/* vpdsi_kd_min_ratio over candidates (+INFINITY: none), the first of equal ones in *arg (or
+ * NULL). */
 double vpdsi_kd_list_min_ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
                                const int32_t *cand, size_t n, const double *y, double slack,
-                               double ry, int rule);
+                               double ry, int rule, int32_t *arg);
+/* Every sample that may be vpdsi_kd_min_ratio's (slack 0) at a point of the box [lo, hi] with
+ * ry in [r_lo, r_hi]: those whose ratio there may come within 1e-9 of the smallest upper bound
+ * (the farthest point of the box, the smallest f). Appended to *out in the tree's order
+ * (grown with m); -1 on OOM. Over them vpdsi_kd_list_min_ratio gives the same minimum. */
+int vpdsi_kd_ratio_candidates(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *lo,
+                              const double *hi, double r_lo, double r_hi, int rule, vpdsi_mem *m,
+                              int32_t **out, size_t *count, size_t *cap);
+/* The same over a list of such candidates of an enclosing box (with an r range no narrower),
+ * in the list's order, into out (room for n; not overlapping from); their count. */
+size_t vpdsi_kd_list_ratio_candidates(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
+                                      const int32_t *from, size_t n, const double *lo,
+                                      const double *hi, double r_lo, double r_hi, int rule,
+                                      int32_t *out);
 
 /* All samples with |x - p| <= radius, appended to *out; -1 on OOM. */
 int vpdsi_kd_radius(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *p,

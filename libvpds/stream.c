@@ -37,6 +37,7 @@ void vpdsi_stream_release(vpdsi_stream *sm, vpdsi_mem *m)
     vpdsi_mem_free(m, sm->cand, sm->cap_cand * sizeof(int32_t));
     vpdsi_mem_free(m, sm->cand_x, sm->cap_cand_x * sizeof(double));
     vpdsi_mem_free(m, sm->lists, sm->cap_lists * sizeof(int32_t));
+    vpdsi_mem_free(m, sm->near, sm->cap_near * sizeof(int32_t));
     vpdsi_stream_init(sm);
 }
 
@@ -195,8 +196,69 @@ static double stream_tolerance(const vpdsi_ctx *ctx)
 
 /* Exact g at each of n centres (and argmin), and an upper bound of g over the box of half
  * sides half around each: (|c - x*| + h) / f(r(x*), r(c) - L h), x* the argmin at c. */
-static vpds_status eval_boxes(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centres, size_t n, const double *half,
-                              double *g, double *ub)
+/* Version 8: one split's samples that may be the weighted nearest at a point of the box its
+ * n centres (each +- half) span, for r within L * |half| of r at the centres (sm->buf), so that
+ * the split's children filter them for their own children: from the parent's list (list->count
+ * >= 0) or one query of the tree, instead of one query per centre. Appended to sm->near; *list
+ * then names them. */
+typedef struct {
+    long from, count; /* in sm->near; count < 0: none */
+} near_list;
+
+static vpds_status near_centres(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centres,
+                                size_t n, const double *half, near_list *list)
+{
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_store *st = ctx->st;
+    int d = pb->dim, k;
+    double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], r_lo = INFINITY, r_hi = 0, h = 0;
+    vpdsi_kd_samples v = vpdsi_store_view(st);
+    size_t j, got = sm->n_near, need;
+    for (k = 0; k < d; k++) {
+        lo[k] = hi[k] = centres[k];
+        h += half[k] * half[k];
+    }
+    for (j = 0; j < n; j++) {
+        for (k = 0; k < d; k++) {
+            double c = centres[j * (size_t)d + (size_t)k];
+            if (c < lo[k]) lo[k] = c;
+            if (c > hi[k]) hi[k] = c;
+        }
+        if (sm->buf[j] < r_lo) r_lo = sm->buf[j];
+        if (sm->buf[j] > r_hi) r_hi = sm->buf[j];
+    }
+    for (k = 0; k < d; k++) {
+        lo[k] -= half[k];
+        hi[k] += half[k];
+    }
+    r_lo -= st->sizing.lipschitz * sqrt(h);
+    r_hi += st->sizing.lipschitz * sqrt(h);
+    if (list->count < 0) {
+        if (vpdsi_kd_ratio_candidates(&st->tree, &v, lo, hi, r_lo, r_hi, (int)pb->rule, ctx->mem,
+                                      &sm->near, &got, &sm->cap_near))
+            goto oom;
+    } else {
+        need = sm->n_near + (size_t)list->count;
+        if (vpdsi_mem_reserve(ctx->mem, (void **)&sm->near, &sm->cap_near, need, sizeof(int32_t)))
+            goto oom;
+        got += vpdsi_kd_list_ratio_candidates(&st->tree, &v, sm->near + list->from,
+                                              (size_t)list->count, lo, hi, r_lo, r_hi,
+                                              (int)pb->rule, sm->near + sm->n_near);
+    }
+    list->from = (long)sm->n_near;
+    list->count = (long)(got - sm->n_near);
+    sm->n_near = got;
+    return VPDS_OK;
+oom:
+    vpdsi_store_error(st, "out of memory in the stream's search");
+    return VPDS_ERR_OUT_OF_MEMORY;
+}
+
+/* g and an upper bound of g over each box (centres, half sides `half`); list (version 8, or
+ * NULL): in, the samples that may be nearest in the enclosing box (count < 0: read the tree),
+ * out, those of these boxes (near_centres). */
+static vpds_status eval_boxes(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centres,
+                              size_t n, const double *half, near_list *list, double *g, double *ub)
 {
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_store *st = ctx->st;
@@ -218,6 +280,8 @@ static vpds_status eval_boxes(vpdsi_stream *sm, const vpdsi_ctx *ctx, const doub
     } else {
         for (j = 0; j < n; j++) sm->buf[j] = st->sizing.radius;
     }
+    if (list && st->tree.n_nodes > 0 && (e = near_centres(sm, ctx, centres, n, half, list)) != VPDS_OK)
+        return e;
     for (j = 0; j < n; j++) {
         const double *c = centres + j * (size_t)d;
         double rc = sm->buf[j], r_lo = rc - L * h, phi = 0;
@@ -231,7 +295,10 @@ static vpds_status eval_boxes(vpdsi_stream *sm, const vpdsi_ctx *ctx, const doub
                 continue;
             }
         }
-        q = vpdsi_kd_min_ratio(&st->tree, &v, c, 0.0, rc, (int)pb->rule, &arg);
+        q = list && list->count >= 0
+                ? vpdsi_kd_list_min_ratio(&st->tree, &v, sm->near + list->from, (size_t)list->count,
+                                          c, 0.0, rc, (int)pb->rule, &arg)
+                : vpdsi_kd_min_ratio(&st->tree, &v, c, 0.0, rc, (int)pb->rule, &arg);
         g[j] = phi > 0 ? -1 : q / pb->coverage;
         if (arg < 0) {
             ub[j] = INFINITY;
@@ -258,15 +325,21 @@ typedef struct {
     double *y;
     double tol;
     int heap;            /* version 5: the open boxes form a max-heap by bound */
+    int lists;           /* version 8: each split reads the list of its parent (near_list) */
 } region_search;
 
-/* Version 5's open boxes: a max-heap by bound (records of 1 + 2d doubles, the bound first).
+/* An open box: its bound, centre, half sides, and (version 8) the split's list it reads
+ * (near_list: from, count). */
+#define BOX_WORDS(d) (3 + 2 * (size_t)(d))
+#define NEAR_POOL_MAX ((size_t)1 << 18) /* 1 MB of lists per search */
+
+/* Version 5's open boxes: a max-heap by bound (records of BOX_WORDS doubles, the bound first).
  * Versions 1-4 scan a list for the first largest bound: the same boxes are split, in another
  * order where bounds tie; a flat maximum leaves tens of thousands open, and the scan of each
  * split was most of such a search's time. */
 static void box_sift_up(vpdsi_stream *sm, size_t i)
 {
-    size_t w = 1 + 2 * (size_t)sm->geom.dim;
+    size_t w = BOX_WORDS(sm->geom.dim);
     while (i > 0) {
         size_t p = (i - 1) / 2;
         if (!(sm->boxes[p * w] < sm->boxes[i * w])) break;
@@ -277,7 +350,7 @@ static void box_sift_up(vpdsi_stream *sm, size_t i)
 
 static void box_sift_down(vpdsi_stream *sm, size_t i)
 {
-    size_t w = 1 + 2 * (size_t)sm->geom.dim, n = sm->n_boxes;
+    size_t w = BOX_WORDS(sm->geom.dim), n = sm->n_boxes;
     for (;;) {
         size_t l = 2 * i + 1, r = l + 1, m = i;
         if (l < n && sm->boxes[l * w] > sm->boxes[m * w]) m = l;
@@ -292,17 +365,25 @@ static void box_sift_down(vpdsi_stream *sm, size_t i)
  * may improve the best point; those that may still beat it by more than the tolerance stay
  * open, the others leave only their bound. */
 static vpds_status split_box(vpdsi_stream *sm, const vpdsi_ctx *ctx, region_search *q,
-                             const double *cb, const double *hb)
+                             const double *cb, const double *hb, const double *parent_list)
 {
     int d = sm->geom.dim, k;
-    size_t w = 1 + 2 * (size_t)d, children = (size_t)1 << d, j;
+    size_t w = BOX_WORDS(d), children = (size_t)1 << d, j;
     double *cs, *gs, *ubs;
+    near_list list;
+    int use;
     vpds_status e;
     kid_arrays(sm, &cs, &gs, &ubs);
     for (j = 0; j < children; j++)
         for (k = 0; k < d; k++)
             cs[j * (size_t)d + (size_t)k] = cb[k] + ((j >> k) & 1u ? hb[k] : -hb[k]);
-    if ((e = eval_boxes(sm, ctx, cs, children, hb, gs, ubs)) != VPDS_OK) return e;
+    list.from = (long)parent_list[0];
+    list.count = (long)parent_list[1];
+    /* a search that splits without end (a flat maximum) reads the tree once the lists hold
+     * NEAR_POOL_MAX entries, so that its memory stays what it was without them */
+    use = q->lists && sm->n_near < NEAR_POOL_MAX;
+    if ((e = eval_boxes(sm, ctx, cs, children, hb, use ? &list : NULL, gs, ubs)) != VPDS_OK)
+        return e;
     if (vpdsi_mem_reserve(ctx->mem, (void **)&sm->boxes, &sm->cap_boxes,
                           (sm->n_boxes + children) * w, sizeof(double))) {
         vpdsi_store_error(ctx->st, "out of memory in the stream's search");
@@ -326,6 +407,8 @@ static vpds_status split_box(vpdsi_stream *sm, const vpdsi_ctx *ctx, region_sear
         r[0] = ubs[j];
         memcpy(r + 1, cs + j * (size_t)d, (size_t)d * sizeof(double));
         memcpy(r + 1 + d, hb, (size_t)d * sizeof(double));
+        r[1 + 2 * d] = use ? (double)list.from : 0;
+        r[2 + 2 * d] = use ? (double)list.count : -1;
         if (q->heap) box_sift_up(sm, sm->n_boxes - 1);
     }
     return VPDS_OK;
@@ -334,7 +417,7 @@ static vpds_status split_box(vpdsi_stream *sm, const vpdsi_ctx *ctx, region_sear
 /* The open box of the largest bound: the heap's top, or (versions 1-4) the first of a scan. */
 static size_t best_box(const vpdsi_stream *sm, int heap, double *top)
 {
-    size_t w = 1 + 2 * (size_t)sm->geom.dim, j, at = 0;
+    size_t w = BOX_WORDS(sm->geom.dim), j, at = 0;
     *top = -1;
     if (heap) {
         if (sm->n_boxes > 0) *top = sm->boxes[0];
@@ -540,16 +623,18 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
                                  double *y, double *gy)
 {
     int d = ctx->pb->dim, k;
-    size_t w = 1 + 2 * (size_t)d;
+    size_t w = BOX_WORDS(d);
     double g1, ub1, mag = box_magnitude(ctx->pb);
     region_search q;
     long splits, budget = STREAM_SEARCH_BUDGET;
     vpds_status e;
     q.tol = stream_tolerance(ctx);
     q.heap = ctx->pb->algorithm >= 5;
+    q.lists = ctx->pb->algorithm >= 8;
+    sm->n_near = 0;
     q.extra = -1;
     q.y = y;
-    if ((e = eval_boxes(sm, ctx, centre, 1, half, &g1, &ub1)) != VPDS_OK) return e;
+    if ((e = eval_boxes(sm, ctx, centre, 1, half, NULL, &g1, &ub1)) != VPDS_OK) return e;
     q.best = g1;
     memcpy(y, centre, (size_t)d * sizeof(double));
     sm->n_boxes = 0;
@@ -560,9 +645,11 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
     sm->boxes[0] = ub1;
     memcpy(sm->boxes + 1, centre, (size_t)d * sizeof(double));
     memcpy(sm->boxes + 1 + d, half, (size_t)d * sizeof(double));
+    sm->boxes[1 + 2 * d] = 0;
+    sm->boxes[2 + 2 * d] = -1; /* no list yet: its split reads the tree */
     sm->n_boxes = 1;
     for (splits = 0;; splits++) {
-        double top, hb[VPDS_MAX_DIM], cb[VPDS_MAX_DIM], hmax = 0, U;
+        double top, hb[VPDS_MAX_DIM], cb[VPDS_MAX_DIM], hmax = 0, U, list[2];
         size_t at;
         if (splits == budget) {
             /* A maximum flat over a wide area (rule current on a radius ramping to zero: the
@@ -595,6 +682,7 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
         /* take the best box out, split it in 2^d */
         memcpy(cb, sm->boxes + at * w + 1, (size_t)d * sizeof(double));
         memcpy(hb, sm->boxes + at * w + 1 + d, (size_t)d * sizeof(double));
+        memcpy(list, sm->boxes + at * w + 1 + 2 * d, 2 * sizeof(double));
         memmove(sm->boxes + at * w, sm->boxes + (sm->n_boxes - 1) * w, w * sizeof(double));
         sm->n_boxes--;
         if (q.heap) box_sift_down(sm, at);
@@ -611,7 +699,7 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
             if (phi <= 0 && top > q.extra) q.extra = top;
             continue;
         }
-        if ((e = split_box(sm, ctx, &q, cb, hb)) != VPDS_OK) return e;
+        if ((e = split_box(sm, ctx, &q, cb, hb, list)) != VPDS_OK) return e;
     }
 }
 
@@ -744,7 +832,7 @@ static vpds_status split_if_coarse(vpdsi_stream *sm, const vpdsi_ctx *ctx, uint6
     /* every callback answers before the heap changes (vpdsi_stream_next) */
     if (v3 && !isfinite(key) && n > 0) {
         for (k = 0; k < d; k++) hs[k] = 0.5 * half[k];
-        if ((e = eval_boxes(sm, ctx, cs, (size_t)n, hs, gs, ubs)) != VPDS_OK) return e;
+        if ((e = eval_boxes(sm, ctx, cs, (size_t)n, hs, NULL, gs, ubs)) != VPDS_OK) return e;
     }
     *split = 1;
     heap_pop(sm, rec);
@@ -769,7 +857,7 @@ static vpds_status bound_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, double k
      * maximiser only when it is within the tolerance of the key */
     if (*gy >= 0 && (!v3 || *gy * (1 + tol) >= key)) {
         double g1, ub1, zero[VPDS_MAX_DIM] = {0};
-        vpds_status e = eval_boxes(sm, ctx, y, 1, zero, &g1, &ub1);
+        vpds_status e = eval_boxes(sm, ctx, y, 1, zero, NULL, &g1, &ub1);
         if (e != VPDS_OK) return e;
         /* (the exact search's g(y) is its own arithmetic's: equal to round-off) */
         if (g1 == *gy || (exact && g1 >= *gy * (1 - EXACT_ROUNDING))) {

@@ -25,6 +25,9 @@ typedef struct vpdsi_stream {
     int32_t *cand; size_t n_cand, cap_cand; /* samples within reach of the region */
     double *cand_x; size_t cap_cand_x;      /* their images within reach of it */
     int32_t *lists; size_t cap_lists;       /* the candidates left at each depth of the split */
+    /* version 8: the samples that may be nearest in an open box of the search, one list per
+     * split shared by its children, which filter it for theirs */
+    int32_t *near; size_t n_near, cap_near;
 } vpdsi_stream;
 
 void vpdsi_stream_init(vpdsi_stream *sm);

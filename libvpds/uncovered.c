@@ -90,7 +90,7 @@ static int near_uncovered(bb_search *q, int depth, const double *c2, double thr)
     }
     if (!me->u_ok) return vpdsi_uncovered_near(q->u, c2, thr);
     return !(vpdsi_kd_list_min_ratio(&q->u->tree, &q->uview, q->u->lists + off, me->u_n, c2, 0.0, 1.0,
-                                     (int)VPDS_RULE_PRIOR) > thr);
+                                     (int)VPDS_RULE_PRIOR, NULL) > thr);
 }
 
 /* This box's samples, from its parent's list while r stays below the parent's bound, else from

@@ -292,11 +292,13 @@ int main(void)
         vpds_destroy(s);
     }
 
-    /* allocation failures during a stream (one and two radii, from empty): each allocation of
-     * the stream fails once in turn; a retry gives the points and t of a stream without them */
+    /* allocation failures during a stream (one and two radii, from empty, and a ramp, whose
+     * search to the tolerance keeps lists of the samples near its boxes from version 8): each
+     * allocation of the stream fails once in turn; a retry gives the points and t of a stream
+     * without them */
     {
         int two;
-        for (two = 0; two < 2; two++) {
+        for (two = 0; two < 3; two++) {
             enum { N = 250 };
             double ref[N * 2], ref_t[N], x[2], t;
             failing_alloc fa;
@@ -304,8 +306,12 @@ int main(void)
             vpds_sampler *s;
             size_t i, k, total, failures = 0, stride;
             d.radius = 0.05;
-            d.inhibition = two ? 0.5 : 1;
+            d.inhibition = two == 1 ? 0.5 : 1;
             d.seed = 11;
+            if (two == 2) {
+                d.sizing = ramp;
+                d.lipschitz = 0.03;
+            }
             d.allocator.alloc = fa_alloc;
             d.allocator.free = fa_free;
             d.allocator.user = &fa;
@@ -328,8 +334,8 @@ int main(void)
                         failures++;
                     }
                     CHECK_MSG(st == VPDS_OK && memcmp(x, ref + 2 * i, sizeof x) == 0 && t == ref_t[i],
-                              "%s radii: sample %zu differs after failing allocation %zu",
-                              two ? "two" : "one", i, k);
+                              "%s: sample %zu differs after failing allocation %zu",
+                              two == 2 ? "a ramp" : two ? "two radii" : "one radius", i, k);
                     if (st != VPDS_OK) break;
                 }
                 vpds_destroy(s);
@@ -337,7 +343,7 @@ int main(void)
             }
             CHECK(failures > 0);
             printf("stream allocation failures (%s): %zu allocations, %zu failed once each\n",
-                   two ? "two radii" : "one radius", total, failures);
+                   two == 2 ? "a ramp" : two ? "two radii" : "one radius", total, failures);
         }
     }
     CHECK_DONE();
