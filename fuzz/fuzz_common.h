@@ -84,38 +84,52 @@ static void check_pair(const vpds_sampler *s, size_t i, size_t j, const double *
     FUZZ_ASSERT(d2 >= f * f, "sample %zu conflicts with %zu (%g < %g)", i, j, sqrt(d2), f);
 }
 
-static const double *sort_key;
-static int by_first_coordinate(const void *a, const void *b)
+/* Samples sorted by the binary exponent of r, then by the first coordinate. */
+typedef struct {
+    int cls;   /* frexp exponent of r */
+    double x0; /* first coordinate */
+    size_t i;
+} sorted_sample;
+
+static int by_class_then_x0(const void *a, const void *b)
 {
-    double u = sort_key[*(const size_t *)a], v = sort_key[*(const size_t *)b];
-    return u < v ? -1 : u > v;
+    const sorted_sample *u = (const sorted_sample *)a, *v = (const sorted_sample *)b;
+    if (u->cls != v->cls) return u->cls < v->cls ? -1 : 1;
+    return u->x0 < v->x0 ? -1 : u->x0 > v->x0;
 }
 
-/* The samples in sorted order whose first coordinate lies within w of sample `at`'s (ranks
- * [*a, *b]; x0 holds the sorted first coordinates, rank the rank of each sample). */
-static void window(const double *x0, size_t n, size_t rank, double w, size_t *a, size_t *b)
+/* Sample i against every earlier sample of one radius class (sorted entries [a, b), radii at
+ * most r_max) whose first coordinate lies within w of i's: those beyond cannot conflict. */
+static void check_class(const vpds_sampler *s, size_t i, const sorted_sample *e, size_t a,
+                        size_t b, double w, const double *lo, const double *hi, vpds_rule rule,
+                        double inhibition, const int *periodic)
 {
-    *a = *b = rank;
-    while (*a > 0 && x0[*a - 1] > x0[rank] - w) --*a;
-    while (*b + 1 < n && x0[*b + 1] < x0[rank] + w) ++*b;
+    double x = vpds_points(s)[i * (size_t)vpds_dim(s)];
+    size_t lo_i = a, hi_i = b, q;
+    while (lo_i < hi_i) { /* the first entry with x0 > x - w */
+        size_t mid = lo_i + (hi_i - lo_i) / 2;
+        if (e[mid].x0 > x - w) hi_i = mid; else lo_i = mid + 1;
+    }
+    for (q = lo_i; q < b && e[q].x0 < x + w; q++)
+        if (e[q].i < i) check_pair(s, i, e[q].i, lo, hi, rule, inhibition, periodic);
 }
 
 /* Samples `from` on: finite, r > 0, inside the box unless fixed, and none conflicts with one
  * before it (check_pair); a harness that checked the earlier ones passes from = how many it
  * checked. Every rule's f is at most max(r_i, r_j), so a conflict needs |x0_i - x0_j| < t_i *
- * inhibition * r_i or < t_i * inhibition * r_j: on an open first axis each new sample i is
- * checked against the earlier ones within twice the first of it along x0, and each sample j
- * against the new ones within twice the second (with the largest new t), not against all: the
- * fuzzer's slowest inputs hold thousands of samples. */
+ * inhibition * max(r_i, r_j): on an open first axis the samples are grouped by the binary
+ * exponent of r (within a group r varies by at most 2x) and sorted by x0 in each, and a new
+ * sample is checked against those of each group within twice that bound along x0 (the group's
+ * largest r for r_j), not against all: the fuzzer's slowest inputs hold thousands. */
 static void check_samples_since(const vpds_sampler *s, size_t from, const double *lo,
                                 const double *hi, vpds_rule rule, double inhibition,
                                 const int *periodic)
 {
-    size_t n = vpds_count(s), i, j, a, b, *order = NULL, *rank = NULL;
+    size_t n = vpds_count(s), i, j, a, b;
     int d = vpds_dim(s), k;
     const double *x = vpds_points(s), *r = vpds_radii(s), *t = vpds_scales(s);
     const uint8_t *fl = vpds_flags(s);
-    double t_max = 0, *x0 = NULL;
+    sorted_sample *e;
     if (rule == VPDS_RULE_DEFAULT) rule = VPDS_RULE_SMALLER;
     for (i = from; i < n; i++) {
         FUZZ_ASSERT(isfinite(r[i]) && r[i] > 0, "r[%zu] = %g", i, r[i]);
@@ -126,7 +140,6 @@ static void check_samples_since(const vpds_sampler *s, size_t from, const double
         }
         if (fl[i] & VPDS_FLAG_FIXED) FUZZ_ASSERT(isinf(t[i]), "fixed point %zu has t = %g", i, t[i]);
         else FUZZ_ASSERT(t[i] >= 0, "t[%zu] = %g", i, t[i]); /* inf: a stream's first sample */
-        if (!(fl[i] & VPDS_FLAG_FIXED) && t[i] > t_max) t_max = t[i];
     }
     if (n <= 64 || (periodic && periodic[0])) { /* every pair */
         for (i = from; i < n; i++)
@@ -134,35 +147,25 @@ static void check_samples_since(const vpds_sampler *s, size_t from, const double
                 check_pair(s, i, j, lo, hi, rule, inhibition, periodic);
         return;
     }
-    order = (size_t *)malloc(n * sizeof *order);
-    x0 = (double *)malloc(n * sizeof *x0);
-    rank = (size_t *)malloc(n * sizeof *rank);
-    FUZZ_ASSERT(order && x0 && rank, "out of memory checking %zu samples", n);
+    e = (sorted_sample *)malloc(n * sizeof *e);
+    FUZZ_ASSERT(e != NULL, "out of memory checking %zu samples", n);
     for (i = 0; i < n; i++) {
-        order[i] = i;
-        x0[i] = x[i * d];
+        frexp(r[i], &e[i].cls);
+        e[i].x0 = x[i * d];
+        e[i].i = i;
     }
-    sort_key = x0;
-    qsort(order, n, sizeof *order, by_first_coordinate);
-    for (i = 0; i < n; i++) x0[i] = x[order[i] * d]; /* now sorted */
-    for (i = 0; i < n; i++) rank[order[i]] = i;
-    for (i = from; i < n; i++) { /* within t_i * inhibition * r_i of i */
-        if (fl[i] & VPDS_FLAG_FIXED) continue;
-        window(x0, n, rank[i], 2 * t[i] * inhibition * r[i], &a, &b);
-        for (; a <= b; a++)
-            if (order[a] < i) check_pair(s, i, order[a], lo, hi, rule, inhibition, periodic);
-    }
-    for (j = 0; j < n; j++) { /* within t_max * inhibition * r_j of j */
-        window(x0, n, rank[j], 2 * t_max * inhibition * r[j], &a, &b);
-        for (; a <= b; a++) {
-            i = order[a];
-            if (i > j && i >= from && !(fl[i] & VPDS_FLAG_FIXED))
-                check_pair(s, i, j, lo, hi, rule, inhibition, periodic);
+    qsort(e, n, sizeof *e, by_class_then_x0);
+    for (a = 0; a < n; a = b) { /* one class [a, b) at a time */
+        double r_max = 0;
+        for (b = a; b < n && e[b].cls == e[a].cls; b++) r_max = r[e[b].i] > r_max ? r[e[b].i] : r_max;
+        for (i = from; i < n; i++) {
+            double w = 2 * t[i] * inhibition * (r[i] > r_max ? r[i] : r_max); /* 2: round-off */
+            if (fl[i] & VPDS_FLAG_FIXED) continue;
+            if (isnan(w)) w = INFINITY;
+            check_class(s, i, e, a, b, w, lo, hi, rule, inhibition, periodic);
         }
     }
-    free(order);
-    free(x0);
-    free(rank);
+    free(e);
 }
 
 /* All the samples so far, as check_samples_since. */
