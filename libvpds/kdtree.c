@@ -486,16 +486,20 @@ double vpdsi_kd_list_min_ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
     return best;
 }
 
-/* A sample's ratio over the box, from below (nearest point, largest f) and above. */
-static void ratio_bounds(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i,
-                         const double *lo, const double *hi, double r_lo, double r_hi, int rule,
-                         double *lb, double *ub)
+/* A sample's ratio over the box from below (nearest point, largest f) and from above. */
+static double ratio_lb(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i,
+                       const double *lo, const double *hi, double r_hi, int rule)
 {
-    const double *x = s->x + (size_t)i * (size_t)t->dim;
-    double f_hi = vpdsi_rule_f((vpds_rule)rule, s->r[i], r_hi);
-    double f_lo = vpdsi_rule_f((vpds_rule)rule, s->r[i], r_lo);
-    *lb = f_hi > 0 ? sqrt(vpdsi_box_mindist2(t, x, lo, hi)) / f_hi : 0;
-    *ub = f_lo > 0 ? sqrt(vpdsi_box_maxdist2(t, x, lo, hi)) / f_lo : INFINITY;
+    double f = vpdsi_rule_f((vpds_rule)rule, s->r[i], r_hi);
+    return f > 0 ? sqrt(vpdsi_box_mindist2(t, s->x + (size_t)i * (size_t)t->dim, lo, hi)) / f : 0;
+}
+
+static double ratio_ub(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i,
+                       const double *lo, const double *hi, double r_lo, int rule)
+{
+    double f = vpdsi_rule_f((vpds_rule)rule, s->r[i], r_lo);
+    return f > 0 ? sqrt(vpdsi_box_maxdist2(t, s->x + (size_t)i * (size_t)t->dim, lo, hi)) / f
+                 : INFINITY;
 }
 
 size_t vpdsi_kd_list_ratio_candidates(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
@@ -503,16 +507,14 @@ size_t vpdsi_kd_list_ratio_candidates(const vpdsi_kdtree *t, const vpdsi_kd_samp
                                       const double *hi, double r_lo, double r_hi, int rule,
                                       int32_t *out)
 {
-    double best_ub = INFINITY, lb, ub;
+    double best_ub = INFINITY, ub;
     size_t j, count = 0;
     for (j = 0; j < n; j++) {
-        ratio_bounds(t, s, from[j], lo, hi, r_lo, r_hi, rule, &lb, &ub);
+        ub = ratio_ub(t, s, from[j], lo, hi, r_lo, rule);
         if (ub < best_ub) best_ub = ub;
     }
-    for (j = 0; j < n; j++) {
-        ratio_bounds(t, s, from[j], lo, hi, r_lo, r_hi, rule, &lb, &ub);
-        if (lb <= best_ub * (1 + 1e-9)) out[count++] = from[j];
-    }
+    for (j = 0; j < n; j++)
+        if (ratio_lb(t, s, from[j], lo, hi, r_hi, rule) <= best_ub * (1 + 1e-9)) out[count++] = from[j];
     return count;
 }
 
@@ -523,7 +525,7 @@ int vpdsi_kd_ratio_candidates(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, 
     int32_t stack[STACK_MAX];
     int top = 0;
     size_t first = *count, j, kept;
-    double best_ub = INFINITY, lb, ub;
+    double best_ub = INFINITY;
     if (t->n_nodes == 0) return 0;
     stack[top++] = 0;
     while (top > 0) {
@@ -535,9 +537,11 @@ int vpdsi_kd_ratio_candidates(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, 
         if (nd->left < 0) {
             int32_t i;
             for (i = nd->head; i >= 0; i = t->next[i]) {
-                ratio_bounds(t, s, i, lo, hi, r_lo, r_hi, rule, &lb, &ub);
+                double ub = ratio_ub(t, s, i, lo, hi, r_lo, rule);
                 if (ub < best_ub) best_ub = ub;
-                if (lb <= best_ub * (1 + 1e-9) && push_index(m, out, count, cap, i)) return -1;
+                if (ratio_lb(t, s, i, lo, hi, r_hi, rule) <= best_ub * (1 + 1e-9) &&
+                    push_index(m, out, count, cap, i))
+                    return -1;
             }
         } else {
             int near = 0.5 * (lo[nd->axis] + hi[nd->axis]) < nd->split;
@@ -545,10 +549,9 @@ int vpdsi_kd_ratio_candidates(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, 
             stack[top++] = near ? nd->left : nd->right;
         }
     }
-    for (j = kept = first; j < *count; j++) { /* against the final bound, in order */
-        ratio_bounds(t, s, (*out)[j], lo, hi, r_lo, r_hi, rule, &lb, &ub);
-        if (lb <= best_ub * (1 + 1e-9)) (*out)[kept++] = (*out)[j];
-    }
+    for (j = kept = first; j < *count; j++) /* against the final bound, in order */
+        if (ratio_lb(t, s, (*out)[j], lo, hi, r_hi, rule) <= best_ub * (1 + 1e-9))
+            (*out)[kept++] = (*out)[j];
     *count = kept;
     return 0;
 }
