@@ -25,18 +25,17 @@ void vpdsi_surface_init(vpdsi_surface *s)
 
 static void release_pieces(vpdsi_surface *s, vpdsi_mem *m)
 {
-    vpdsi_mem_free(m, s->cur, s->cap_cur * sizeof *s->cur);
-    vpdsi_mem_free(m, s->next, s->cap_next * sizeof *s->next);
+    vpdsi_piece_array_release(&s->cur, m);
+    vpdsi_piece_array_release(&s->next, m);
     vpdsi_mem_free(m, s->cum, s->cap_cum * sizeof *s->cum);
     vpdsi_mem_free(m, s->near, s->cap_near * sizeof *s->near);
     vpdsi_mem_free(m, s->cache, s->cap_cache * sizeof *s->cache);
     vpdsi_mem_free(m, s->seed_m, s->cap_seed_m * sizeof *s->seed_m);
     vpdsi_mem_free(m, s->tri_cum, s->cap_tri_cum * sizeof *s->tri_cum);
-    s->cur = s->next = NULL;
     s->cum = s->tri_cum = NULL;
     s->near = s->cache = NULL;
     s->seed_m = NULL;
-    s->n_cur = s->n_next = s->cap_cur = s->cap_next = s->cap_cum = s->cap_near = s->n_near = 0;
+    s->cap_cum = s->cap_near = s->n_near = 0;
     s->n_cache = s->cap_cache = s->cap_seed_m = s->cap_tri_cum = 0;
     s->cum_ready = s->cache_ok = s->implicit = 0;
 }
@@ -61,7 +60,7 @@ void vpdsi_surface_begin(vpdsi_surface *s, double t)
     s->t = t;
     s->phase = VPDSI_SURF_SEED;
     s->pos = 0;
-    s->n_cur = s->n_next = 0;
+    s->cur.n = s->next.n = 0;
     s->cum_ready = s->cache_ok = s->implicit = 0;
 }
 
@@ -158,10 +157,11 @@ static int corners_covered(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, doubl
 
 /* ---- phases ---- */
 
-static vpds_status reserve_pieces(vpdsi_mem *m, vpdsi_piece **p, size_t *cap, size_t need,
-                                  vpdsi_store *st)
+/* Room for `need` pieces of levels up to max_level (their coordinates below m_max 2^level). */
+static vpds_status reserve_pieces(const vpdsi_surface *s, vpdsi_mem *m, vpdsi_piece_array *a,
+                                  size_t need, unsigned max_level, vpdsi_store *st)
 {
-    if (vpdsi_mem_reserve(m, (void **)p, cap, need, sizeof **p)) {
+    if (vpdsi_piece_array_reserve(a, m, need, vpdsi_lattice_bits(s->m_max) + max_level)) {
         vpdsi_store_error(st, "out of memory for %zu active pieces", need);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
@@ -242,6 +242,7 @@ static vpds_status seed_step(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, uin
             return VPDS_ERR_OUT_OF_MEMORY;
         }
         s->seed_total = 0;
+        s->m_max = 0;
     }
     for (; s->pos < mesh->n_live && *done < limit; s->pos++, (*done)++) {
         double r, ratio, m;
@@ -261,6 +262,7 @@ static vpds_status seed_step(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, uin
             return VPDS_ERR_OVERFLOW;
         }
         s->seed_m[s->pos] = (uint64_t)m;
+        if ((uint64_t)m > s->m_max) s->m_max = (uint64_t)m;
         s->seed_total += (uint64_t)m * (uint64_t)m;
         s->tri_cum[s->pos] = (s->pos ? s->tri_cum[s->pos - 1] : 0) + mesh->area[s->pos];
     }
@@ -302,7 +304,8 @@ static void draw_piece_dart(const vpdsi_surface *s, const vpdsi_surface_ctx *ctx
                                       vpdsi_rng_unit(ctx->rng) * s->tri_cum[mesh->n_live - 1]);
         scale = 1;
     } else {
-        p = s->cur[search_running_sums(s->cum, s->n_cur, vpdsi_rng_unit(ctx->rng) * s->cum[s->n_cur - 1])];
+        p = vpdsi_piece_array_get(&s->cur, search_running_sums(s->cum, s->cur.n,
+                                  vpdsi_rng_unit(ctx->rng) * s->cum[s->cur.n - 1]));
         scale = ldexp(1.0 / (double)s->seed_m[p.tri], -(int)p.level);
     }
     a = vpdsi_rng_unit(ctx->rng);
@@ -326,12 +329,14 @@ static vpds_status build_piece_sums(vpdsi_surface *s, const vpdsi_surface_ctx *c
 {
     double sum = 0;
     size_t k;
-    if (vpdsi_mem_reserve(ctx->st->mem, (void **)&s->cum, &s->cap_cum, s->n_cur, sizeof *s->cum)) {
-        vpdsi_store_error(ctx->st, "out of memory for the areas of %zu pieces", s->n_cur);
+    if (vpdsi_mem_reserve(ctx->st->mem, (void **)&s->cum, &s->cap_cum, s->cur.n, sizeof *s->cum)) {
+        vpdsi_store_error(ctx->st, "out of memory for the areas of %zu pieces", s->cur.n);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
-    for (k = 0; k < s->n_cur; k++)
-        s->cum[k] = sum += vpdsi_piece_area(ctx->mesh, s->seed_m[s->cur[k].tri], &s->cur[k]);
+    for (k = 0; k < s->cur.n; k++) {
+        vpdsi_piece p = vpdsi_piece_array_get(&s->cur, k);
+        s->cum[k] = sum += vpdsi_piece_area(ctx->mesh, s->seed_m[p.tri], &p);
+    }
     s->cum_ready = 1;
     return VPDS_OK;
 }
@@ -393,7 +398,7 @@ static vpds_status sweep_one_piece(vpdsi_surface *s, const vpdsi_surface_ctx *ct
         return e;
     if (corners_covered(s, ctx, x, r_lo)) return VPDS_OK;
     if (!split || !splittable(ctx, s, p, r_hi)) {
-        s->next[s->n_next++] = *p;
+        vpdsi_piece_array_push(&s->next, p);
         return VPDS_OK;
     }
     s->split_any = 1;
@@ -405,7 +410,7 @@ static vpds_status sweep_one_piece(vpdsi_surface *s, const vpdsi_surface_ctx *ct
          * tighter */
         if (ctx->mesh->vr && (e = vpdsi_piece_bounds(ctx->mesh, ctx->st, c.tri, cuv, cx, &c_lo, &c_hi)) != VPDS_OK)
             return e;
-        if (!corners_covered(s, ctx, cx, c_lo)) s->next[s->n_next++] = c;
+        if (!corners_covered(s, ctx, cx, c_lo)) vpdsi_piece_array_push(&s->next, &c);
         if (c.level + 1u > ctx->stats->levels) ctx->stats->levels = c.level + 1u;
     }
     return VPDS_OK;
@@ -438,37 +443,35 @@ static void advance_seed_cursor(vpdsi_surface *s)
  * no piece could split (the precision limit: delta says how far from maximal). */
 static void finish_piece_sweep(vpdsi_surface *s, const vpdsi_surface_ctx *ctx)
 {
-    vpdsi_piece *tmp = s->cur;
-    size_t cap = s->cap_cur, k;
+    vpdsi_piece_array tmp = s->cur;
+    size_t k;
     int was_filter = s->phase == VPDSI_SURF_FILTER;
     s->cur = s->next;
-    s->cap_cur = s->cap_next;
-    s->n_cur = s->n_next;
     s->next = tmp;
-    s->cap_next = cap;
-    s->n_next = 0;
+    vpdsi_piece_array_clear(&s->next);
     s->pos = 0;
     s->cum_ready = 0;
     s->implicit = 0;
-    if (s->n_cur > ctx->stats->peak_active_cells) ctx->stats->peak_active_cells = s->n_cur;
-    if (s->n_cur == 0) {
+    if (s->cur.n > ctx->stats->peak_active_cells) ctx->stats->peak_active_cells = s->cur.n;
+    if (s->cur.n == 0) {
         ctx->stats->delta = 0;
         s->phase = VPDSI_SURF_DONE;
     } else if (!was_filter && !s->split_any && !s->floor_lifted) {
         /* only pieces below the area floor are left: every dart now lands on them, so they may
          * split after all (down to the coordinates' precision) */
         s->floor_lifted = 1;
-        begin_piece_darts(s, DARTS_PER_SEED_PIECE, (double)s->n_cur);
+        begin_piece_darts(s, DARTS_PER_SEED_PIECE, (double)s->cur.n);
     } else if (!was_filter && !s->split_any) {
         double worst = 0;
-        for (k = 0; k < s->n_cur; k++) {
-            double edge = vpdsi_piece_edge(ctx->mesh, s->seed_m[s->cur[k].tri], &s->cur[k]);
+        for (k = 0; k < s->cur.n; k++) {
+            vpdsi_piece p = vpdsi_piece_array_get(&s->cur, k);
+            double edge = vpdsi_piece_edge(ctx->mesh, s->seed_m[p.tri], &p);
             if (edge > worst) worst = edge;
         }
         ctx->stats->delta = worst;
         s->phase = VPDSI_SURF_DONE;
     } else {
-        begin_piece_darts(s, was_filter ? DARTS_PER_SEED_PIECE : DARTS_PER_PIECE, (double)s->n_cur);
+        begin_piece_darts(s, was_filter ? DARTS_PER_SEED_PIECE : DARTS_PER_PIECE, (double)s->cur.n);
     }
     if (s->phase == VPDSI_SURF_DONE) {
         release_pieces(s, ctx->st->mem);
@@ -480,17 +483,18 @@ static vpds_status piece_sweep_step(vpdsi_surface *s, const vpdsi_surface_ctx *c
                                     uint64_t *done)
 {
     int split = s->phase == VPDSI_SURF_SWEEP;
-    uint64_t left = s->implicit ? s->seed_total - s->ipos : s->n_cur - s->pos;
+    uint64_t left = s->implicit ? s->seed_total - s->ipos : s->cur.n - s->pos;
+    unsigned level = s->implicit ? 0 : s->cur.max_level;
     vpds_status e;
     if (left < limit) limit = left;
-    if ((e = reserve_pieces(ctx->st->mem, &s->next, &s->cap_next, s->n_next + 4 * (size_t)limit,
+    if ((e = reserve_pieces(s, ctx->st->mem, &s->next, s->next.n + 4 * (size_t)limit, level + 1,
                             ctx->st)) != VPDS_OK)
         return e;
     while (*done < limit) {
-        size_t kept = s->n_next;
-        vpdsi_piece p = s->implicit ? seed_cursor_piece(s) : s->cur[s->pos];
+        size_t kept = s->next.n;
+        vpdsi_piece p = s->implicit ? seed_cursor_piece(s) : vpdsi_piece_array_get(&s->cur, s->pos);
         if ((e = sweep_one_piece(s, ctx, &p, split)) != VPDS_OK) {
-            s->n_next = kept;
+            s->next.n = kept;
             return e;
         }
         if (s->implicit) {
@@ -501,7 +505,7 @@ static vpds_status piece_sweep_step(vpdsi_surface *s, const vpdsi_surface_ctx *c
         }
         (*done)++;
     }
-    if (s->implicit ? s->ipos == s->seed_total : s->pos == s->n_cur) finish_piece_sweep(s, ctx);
+    if (s->implicit ? s->ipos == s->seed_total : s->pos == s->cur.n) finish_piece_sweep(s, ctx);
     return VPDS_OK;
 }
 
@@ -510,7 +514,7 @@ static int surface_progress_stops(const vpdsi_surface *s, const vpdsi_surface_ct
     vpds_progress p;
     p.darts = ctx->stats->darts;
     p.samples = ctx->st->n;
-    p.active_cells = s->phase == VPDSI_SURF_DONE ? 0 : s->implicit ? s->seed_total : s->n_cur;
+    p.active_cells = s->phase == VPDSI_SURF_DONE ? 0 : s->implicit ? s->seed_total : s->cur.n;
     p.level = ctx->stats->levels;
     p.t = s->t;
     return ctx->progress(&p, ctx->progress_user) != 0;

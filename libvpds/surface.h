@@ -5,7 +5,7 @@
  * coordinates in the marks beside it. */
 #ifndef VPDS_SURFACE_H
 #define VPDS_SURFACE_H
-#include "pieces.h"
+#include "piece_array.h"
 #include "rng.h"
 
 typedef enum {
@@ -30,8 +30,8 @@ typedef struct vpdsi_surface {
     double cache_lo[3], cache_hi[3], cache_r;
     int cache_ok;
     int32_t last_cover;                  /* the sample that held the last covered piece */
-    vpdsi_piece *cur, *next;             /* active pieces, and those of the next level */
-    size_t n_cur, cap_cur, n_next, cap_next;
+    vpdsi_piece_array cur, next;         /* active pieces, and those of the next level */
+    uint64_t m_max;                      /* the largest seed_m */
     double *cum;  size_t cap_cum;        /* running sums of the active pieces' areas */
     int cum_ready;                       /* cum holds this level's sums */
     size_t pos;                          /* seed: next live triangle; sweeps: next piece */

@@ -1,10 +1,13 @@
 /* The active-cell array (cells.c) against a plain copy: in every dimension, for lattices whose
  * cells fit one 32-bit word and for those that take one or more 64-bit words, the coordinates
  * pushed are the coordinates read back, in order, after compaction by moves too; and a layout
- * of at most 32 bits holds 4 bytes a cell. */
+ * of at most 32 bits holds 4 bytes a cell. The same for a surface's active pieces
+ * (piece_array.c): 16-byte records up to 32 bits, widened with their pieces past it, and a
+ * widening that fails leaves them as they were. */
 #include "check.h"
 #include "vpds.h"
 #include "cells.h"
+#include "piece_array.h"
 #include <stdlib.h>
 #include <string.h>
 
@@ -59,8 +62,72 @@ static void check_layout(int d, const uint64_t *n0, unsigned level, size_t n)
     free(copy);
 }
 
+static vpdsi_piece random_piece(unsigned bits)
+{
+    vpdsi_piece p;
+    uint64_t span = bits >= 64 ? ~UINT64_C(0) : (UINT64_C(1) << bits) - 1;
+    memset(&p, 0, sizeof p);
+    p.i = next_u64() % 3 == 0 ? span : next_u64() & span;
+    p.j = next_u64() & span;
+    p.tri = (uint32_t)next_u64();
+    p.level = (uint8_t)(next_u64() % 60);
+    p.down = (uint8_t)(next_u64() & 1);
+    return p;
+}
+
+static int pieces_equal(const vpdsi_piece_array *a, const vpdsi_piece *copy, size_t n)
+{
+    size_t k;
+    for (k = 0; k < n; k++) {
+        vpdsi_piece p = vpdsi_piece_array_get(a, k);
+        if (p.i != copy[k].i || p.j != copy[k].j || p.tri != copy[k].tri ||
+            p.level != copy[k].level || p.down != copy[k].down)
+            return 0;
+    }
+    return a->n == n;
+}
+
+static void check_pieces(void)
+{
+    enum { N = 3000 };
+    static vpdsi_piece copy[2 * N];
+    vpdsi_piece_array a;
+    vpdsi_mem mem;
+    size_t k, held;
+    vpdsi_mem_init(&mem, NULL);
+    memset(&a, 0, sizeof a);
+    CHECK(vpdsi_piece_array_reserve(&a, &mem, N, 32) == 0 && !a.wide && a.cap < N * 16 + N * 8);
+    for (k = 0; k < N; k++) {
+        copy[k] = random_piece(32);
+        vpdsi_piece_array_push(&a, &copy[k]);
+    }
+    CHECK_MSG(pieces_equal(&a, copy, N), "32-bit pieces read back differ");
+    /* a widening the allocator refuses: the pieces stay, narrow */
+    held = mem.held;
+    mem.limit = held + 1;
+    CHECK(vpdsi_piece_array_reserve(&a, &mem, 2 * N, 33) == -1 && !a.wide && pieces_equal(&a, copy, N));
+    mem.limit = 0;
+    CHECK(vpdsi_piece_array_reserve(&a, &mem, 2 * N, 33) == 0 && a.wide);
+    CHECK_MSG(pieces_equal(&a, copy, N), "pieces differ after widening");
+    for (k = N; k < 2 * N; k++) {
+        copy[k] = random_piece(k % 2 ? 33 : 63);
+        vpdsi_piece_array_push(&a, &copy[k]);
+    }
+    CHECK_MSG(pieces_equal(&a, copy, 2 * N), "wide pieces read back differ");
+    vpdsi_piece_array_clear(&a); /* emptied: narrow again where the level allows */
+    CHECK(vpdsi_piece_array_reserve(&a, &mem, N, 20) == 0 && !a.wide);
+    for (k = 0; k < N; k++) {
+        copy[k] = random_piece(20);
+        vpdsi_piece_array_push(&a, &copy[k]);
+    }
+    CHECK(pieces_equal(&a, copy, N));
+    vpdsi_piece_array_release(&a, &mem);
+    CHECK(mem.held == 0);
+}
+
 int main(void)
 {
+    check_pieces();
     int d, rep;
     unsigned level;
     for (d = 1; d <= VPDS_MAX_DIM; d++)
