@@ -107,7 +107,7 @@ static uint64_t key_of(int l, const uint64_t *c, int dim)
 static int level_of(const vpdsi_ogrid *g, double r)
 {
     int l = 0;
-    while (l + 1 < g->levels && g->lv[l + 1].side >= r) l++;
+    while (l + 1 < g->levels && g->lv[l + 1].side >= 2 * r) l++;
     return l;
 }
 
