@@ -23,9 +23,10 @@ int vpdsi_ogrid_setup(vpdsi_ogrid *g, int dim, const double *lo, const double *h
     /* a box wider than 2^BITS cells of the largest radius: coordinates would be clamped and
      * samples filed where queries do not look */
     if (!(ext / top < (double)CELL_MAX)) return -2;
-    /* levels while a cell coordinate fits its bits; smaller radii share the last level */
+    /* levels while a cell coordinate fits its bits; smaller radii share the last level. The
+     * first is 2 top wide: a sample goes where the side is at least 2r (level_of) */
     for (l = 0; l < VPDSI_OGRID_LEVELS; l++) {
-        double side = ldexp(top, -l);
+        double side = ldexp(2 * top, -l);
         if (l > 0 && !(ext / side < (double)CELL_MAX)) break;
         g->lv[l].side = side;
         g->lv[l].inv = 1 / side;

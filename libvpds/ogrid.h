@@ -1,5 +1,5 @@
 /* The octave grid: the neighbour index of a variable radius in 1-3D. A sample of radius r is
- * filed at the level whose cell side s = top * 2^-level is the smallest at or above 2r (so that
+ * filed at the level whose cell side s = 2 top * 2^-level is the smallest at or above 2r (so that
  * a reach up to r spans two cells per axis, four probes in 2D where r gave up to nine), in one
  * hash table of (level, cell) keys. A query visits, level by level, the cells within that
  * level's reach (from the largest radius it holds, so no bound on L is assumed) and only the
