@@ -98,8 +98,8 @@ static int by_class_then_x0(const void *a, const void *b)
     return u->x0 < v->x0 ? -1 : u->x0 > v->x0;
 }
 
-/* Sample i against every earlier sample of one radius class (sorted entries [a, b), radii at
- * most r_max) whose first coordinate lies within w of i's: those beyond cannot conflict. */
+/* Sample i against every earlier sample of one radius class (sorted entries [a, b)) whose first
+ * coordinate lies within w of i's: those beyond cannot conflict. */
 static void check_class(const vpds_sampler *s, size_t i, const sorted_sample *e, size_t a,
                         size_t b, double w, const double *lo, const double *hi, vpds_rule rule,
                         double inhibition, const int *periodic)

@@ -502,20 +502,30 @@ static double ratio_ub(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t
                  : INFINITY;
 }
 
+/* The samples of from whose lower bound comes within 1e-9 of best_ub, in order, into out (which
+ * may be from: a kept one never moves up); their count. */
+static size_t keep_within(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *from,
+                          size_t n, const double *lo, const double *hi, double r_hi, int rule,
+                          double best_ub, int32_t *out)
+{
+    size_t j, count = 0;
+    for (j = 0; j < n; j++)
+        if (ratio_lb(t, s, from[j], lo, hi, r_hi, rule) <= best_ub * (1 + 1e-9)) out[count++] = from[j];
+    return count;
+}
+
 size_t vpdsi_kd_list_ratio_candidates(const vpdsi_kdtree *t, const vpdsi_kd_samples *s,
                                       const int32_t *from, size_t n, const double *lo,
                                       const double *hi, double r_lo, double r_hi, int rule,
                                       int32_t *out)
 {
     double best_ub = INFINITY, ub;
-    size_t j, count = 0;
+    size_t j;
     for (j = 0; j < n; j++) {
         ub = ratio_ub(t, s, from[j], lo, hi, r_lo, rule);
         if (ub < best_ub) best_ub = ub;
     }
-    for (j = 0; j < n; j++)
-        if (ratio_lb(t, s, from[j], lo, hi, r_hi, rule) <= best_ub * (1 + 1e-9)) out[count++] = from[j];
-    return count;
+    return keep_within(t, s, from, n, lo, hi, r_hi, rule, best_ub, out);
 }
 
 int vpdsi_kd_ratio_candidates(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *lo,
@@ -524,7 +534,7 @@ int vpdsi_kd_ratio_candidates(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, 
 {
     int32_t stack[STACK_MAX];
     int top = 0;
-    size_t first = *count, j, kept;
+    size_t first = *count;
     double best_ub = INFINITY;
     if (t->n_nodes == 0) return 0;
     stack[top++] = 0;
@@ -549,9 +559,8 @@ int vpdsi_kd_ratio_candidates(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, 
             stack[top++] = near ? nd->left : nd->right;
         }
     }
-    for (j = kept = first; j < *count; j++) /* against the final bound, in order */
-        if (ratio_lb(t, s, (*out)[j], lo, hi, r_hi, rule) <= best_ub * (1 + 1e-9))
-            (*out)[kept++] = (*out)[j];
-    *count = kept;
+    /* against the final bound, in order */
+    *count = first + keep_within(t, s, *out + first, *count - first, lo, hi, r_hi, rule, best_ub,
+                                 *out + first);
     return 0;
 }

@@ -194,8 +194,6 @@ static double stream_tolerance(const vpdsi_ctx *ctx)
     return ctx->dom->fn ? VPDS_STREAM_DOMAIN_TOLERANCE : VPDS_STREAM_TOLERANCE;
 }
 
-/* Exact g at each of n centres (and argmin), and an upper bound of g over the box of half
- * sides half around each: (|c - x*| + h) / f(r(x*), r(c) - L h), x* the argmin at c. */
 /* Version 8: one split's samples that may be the weighted nearest at a point of the box its
  * n centres (each +- half) span, for r within L * |half| of r at the centres (sm->buf), so that
  * the split's children filter them for their own children: from the parent's list (list->count
@@ -254,9 +252,10 @@ oom:
     return VPDS_ERR_OUT_OF_MEMORY;
 }
 
-/* g and an upper bound of g over each box (centres, half sides `half`); list (version 8, or
- * NULL): in, the samples that may be nearest in the enclosing box (count < 0: read the tree),
- * out, those of these boxes (near_centres). */
+/* Exact g at each of n centres (and argmin), and an upper bound of g over the box of half
+ * sides half around each: (|c - x*| + h) / f(r(x*), r(c) - L h), x* the argmin at c. list
+ * (version 8, or NULL): in, the samples that may be nearest in the enclosing box (count < 0:
+ * read the tree), out, those of these boxes (near_centres). */
 static vpds_status eval_boxes(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centres,
                               size_t n, const double *half, near_list *list, double *g, double *ub)
 {

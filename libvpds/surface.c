@@ -60,7 +60,8 @@ void vpdsi_surface_begin(vpdsi_surface *s, double t)
     s->t = t;
     s->phase = VPDSI_SURF_SEED;
     s->pos = 0;
-    s->cur.n = s->next.n = 0;
+    vpdsi_piece_array_clear(&s->cur);
+    vpdsi_piece_array_clear(&s->next);
     s->cum_ready = s->cache_ok = s->implicit = 0;
 }
 

@@ -158,6 +158,29 @@ static vpds_status search_box_covered(bb_search *q, int depth, const double *lo,
     return VPDS_OK;
 }
 
+/* Squared distance from y to the anchor (a point: alo = ahi), in the boxes' coordinates. */
+static double anchor_gap2(const bb_search *q, const double *y)
+{
+    double d2 = 0;
+    int k;
+    for (k = 0; k < q->pb->dim; k++) {
+        const double *a = q->alo, *b = q->ahi;
+        double g = y[k] < a[k] ? a[k] - y[k] : y[k] > b[k] ? y[k] - b[k] : 0;
+        d2 += g * g;
+    }
+    return d2;
+}
+
+/* Whether a point at squared distance d2 from the anchor, where r is r_y, lies in the region:
+ * within scale * f(r_anchor, r_y) of a point anchor, within the reach of a box. */
+static int in_region_at(const bb_search *q, double d2, double r_y)
+{
+    double f;
+    if (!q->point) return d2 <= q->reach * q->reach;
+    f = q->scale * vpdsi_rule_f(q->pb->rule, q->r_anchor, r_y);
+    return r_y > 0 && d2 <= f * f;
+}
+
 /* p, uncovered in the region and the domain at r(p) = rp: the search's witness. */
 static vpds_status take_witness(bb_search *q, const double *p, double rp, int *verdict)
 {
@@ -186,25 +209,14 @@ static vpds_status far_corner(bb_search *q, int depth, const double *lo, const d
 {
     int d = q->pb->dim, k;
     const double *x = q->view.x + (size_t)q->cover * (size_t)d;
-    double y[VPDS_MAX_DIM], d2 = 0, ry;
+    double y[VPDS_MAX_DIM], ry;
     vpds_status st;
     for (k = 0; k < d; k++) {
         double P = q->pb->period[k], e = x[k] - 0.5 * (lo[k] + hi[k]);
         if (P > 0) e -= P * floor(e / P + 0.5); /* the image of x nearest the box */
         y[k] = e > 0 ? lo[k] : hi[k];
-        if (q->point) {
-            d2 += (y[k] - q->alo[k]) * (y[k] - q->alo[k]);
-        } else {
-            double g = y[k] < q->alo[k] ? q->alo[k] - y[k] : y[k] > q->ahi[k] ? y[k] - q->ahi[k] : 0;
-            d2 += g * g;
-        }
     }
-    if (q->point) {
-        double f = q->scale * vpdsi_rule_f(q->pb->rule, q->r_anchor, r_lo);
-        if (!(r_lo > 0) || d2 > f * f) return VPDS_OK;
-    } else if (d2 > q->reach * q->reach) {
-        return VPDS_OK;
-    }
+    if (!in_region_at(q, anchor_gap2(q, y), r_lo)) return VPDS_OK;
     if (q->st->sizing.kind == VPDSI_SIZING_CONSTANT) {
         ry = q->st->sizing.radius;
     } else {
@@ -221,7 +233,7 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
                            int *verdict)
 {
     int d = q->pb->dim, k, in_region;
-    double *p = q->p, *c2 = q->c2, gap2 = 0, diag2 = 0, diag, r_lo, r_hi;
+    double *p = q->p, *c2 = q->c2, gap2 = 0, diag2 = 0, diag, r_lo, r_hi, d2;
     vpds_status st;
     *verdict = 0;
     q->drop_kept = 0;
@@ -254,10 +266,9 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
     diag = sqrt(diag2);
     r_lo = q->rp - q->L * diag;
     r_hi = q->rp + q->L * diag;
+    d2 = anchor_gap2(q, p);
+    in_region = in_region_at(q, d2, q->rp);
     if (q->point) {
-        double f = q->scale * vpdsi_rule_f(q->pb->rule, q->r_anchor, q->rp), d2 = 0;
-        for (k = 0; k < d; k++) d2 += (p[k] - q->alo[k]) * (p[k] - q->alo[k]);
-        in_region = d2 <= f * f;
         /* Version 2: the box's nearest point lies beyond f(r_anchor, r) for every r the box
          * holds (f is monotone), so the box misses the region. Version 1 kept such a box when
          * it straddled a coverage boundary, down to the depth limit and a false "uncovered":
@@ -267,14 +278,6 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
             double f_hi = q->scale * vpdsi_rule_f(q->pb->rule, q->r_anchor, r_hi);
             if (d2 > f_hi * f_hi) return VPDS_OK;
         }
-    } else {
-        double d2 = 0;
-        for (k = 0; k < d; k++) {
-            const double *a = q->alo, *b = q->ahi;
-            double g = p[k] < a[k] ? a[k] - p[k] : p[k] > b[k] ? p[k] - b[k] : 0;
-            d2 += g * g;
-        }
-        in_region = d2 <= q->reach * q->reach;
     }
     sample_list(q, depth, lo, hi, q->rp, r_hi, diag);
     q->cover = -1;
