@@ -178,7 +178,8 @@ typedef struct vpds_desc {
     vpds_allocator allocator;
 
     uint64_t budget;            /* work units per call before VPDS_PAUSED (0: none): a dart, a
-                                   cell, or a box of the coverage search (two radii, domains) */
+                                   cell (past 8D: each 256 of a split's 2^d children), or a box
+                                   of the coverage search (two radii, domains) */
     vpds_progress_fn progress;  /* called between chunks of work; may pause */
     void *progress_user;
 

@@ -131,6 +131,48 @@ static double *run_copy(const vpds_desc *d, size_t *n)
     return copy;
 }
 
+/* Counts the chunks of work (the progress callback runs after each one), never pauses. */
+static int count_chunks(const vpds_progress *p, void *user)
+{
+    (void)p;
+    ++*(long *)user;
+    return 0;
+}
+
+/* Past 8D a cell's split makes 2^d children, 2^(d-8) blocks of 256: each block is a unit of
+ * the budget, so that a call stays within its budget there too. A chunk is at most 256 units
+ * (and one cell), so a call of budget B ends within B / 256 + 2 chunks. When a split cell
+ * counted as one unit, a 12D call of budget 4096 ran about 240 chunks of 17 cells (70,000
+ * cells, 280 million children; 278 chunks in a call here), and a 16D fuzz input took seconds
+ * per call. */
+static void test_budget_past_8d(void)
+{
+    vpds_desc d = vpds_default_desc();
+    double hi[12];
+    vpds_sampler *s;
+    vpds_status st;
+    long chunks = 0, calls = 0, worst = 0;
+    int k;
+    for (k = 0; k < 12; k++) hi[k] = 1.0;
+    d.dim = 12;
+    d.hi = hi;
+    d.radius = 1.8; /* 2^12 base cells, each split into 4096 children */
+    d.seed = 5;
+    d.budget = 4096;
+    d.progress = count_chunks;
+    d.progress_user = &chunks;
+    CHECK(vpds_create(&d, &s) == VPDS_OK);
+    do {
+        chunks = 0;
+        st = vpds_run(s);
+        calls++;
+        if (chunks > worst) worst = chunks;
+    } while (st == VPDS_PAUSED && calls < 40);
+    CHECK_MSG(worst <= 4096 / 256 + 2, "a call of budget 4096 in 12D ran %ld chunks", worst);
+    CHECK_MSG(vpds_get_stats(s).levels > 1, "no cell was split (%u levels)", vpds_get_stats(s).levels);
+    vpds_destroy(s);
+}
+
 static int pause_every_third(const vpds_progress *p, void *user)
 {
     int *calls = (int *)user;
@@ -195,6 +237,8 @@ int main(void)
             vpds_destroy(s);
         }
     }
+
+    test_budget_past_8d();
 
     /* the progress callback pauses; calling again continues to the same points */
     {
