@@ -122,3 +122,75 @@ def test_weighted_bias_free(sample):
     print(f"weighted ranks: KS p-values weighted process {p[1]}, plain process {p[0]}")
     assert min(p[1]) > 1e-3, p[1]
     assert min(p[0]) < 1e-3, p[0]
+
+
+# 4D-6D: the same ranks where a raster of the free region is out of reach. A pool of points
+# uniform in the box stands in for it: for each pool point, the first sample that conflicts with
+# it; the free region of a prefix x[:k] is then the pool points whose first conflict comes at k
+# or later, uniform on it. Within a run the ranks at several k are independent Uniform(0, 1) too
+# (each is uniform given all the samples before it), so a run gives one per k of a fixed stride;
+# a prefix whose free region holds too few pool points is skipped (a choice that depends on the
+# prefix only, never on the sample after it).
+HIGH = [(4, 0.25), (5, 0.35), (6, 0.6)]
+HIGH_RUNS = 30
+HIGH_PER_RUN = 20
+POOL = 40_000
+
+
+def first_conflict(pool, x, radius):
+    """For each pool point, the index of the first sample closer than radius (len(x): none)."""
+    first = np.full(len(pool), len(x))
+    alive = np.arange(len(pool))
+    for i, xi in enumerate(x):
+        hit = ((pool[alive] - xi) ** 2).sum(axis=1) < radius * radius
+        first[alive[hit]] = i
+        alive = alive[~hit]
+        if len(alive) == 0:
+            break
+    return first
+
+
+def ranks_nd(free, prefix, y):
+    """Ranks of y among the free points by its first and last coordinates and its distance to
+    the nearest sample of the prefix."""
+    tree = cKDTree(prefix)
+    dfree, _ = tree.query(free)
+    dy, _ = tree.query(y)
+    return [np.mean(free[:, 0] < y[0]), np.mean(free[:, -1] < y[-1]), np.mean(dfree < dy)]
+
+
+def bridson_next_nd(prefix, radius, rng):
+    """The biased insertion of bridson_next in any dimension, for a constant radius."""
+    d = prefix.shape[1]
+    for _ in range(5000):
+        u = rng.normal(size=d)
+        y = prefix[rng.integers(len(prefix))] + radius * (1 + rng.random()) * u / np.linalg.norm(u)
+        if np.all((y >= 0) & (y <= 1)) and np.all(np.linalg.norm(prefix - y, axis=1) >= radius):
+            return y
+    return None
+
+
+@pytest.mark.parametrize("dim,radius", HIGH)
+def test_bias_free_high_dims(sample, dim, radius):
+    rng = np.random.default_rng(11 + dim)
+    ours, biased = [], []
+    for seed in range(HIGH_RUNS):
+        x, r, _ = sample(dim, "smaller", "const", radius, 3000 + seed, 0.0, 1.0)
+        assert np.all(r == radius)
+        pool = rng.random((POOL, dim))
+        first = first_conflict(pool, x, radius)
+        for k in range(1, len(x), max(1, len(x) // HIGH_PER_RUN)):
+            free = pool[first >= k]
+            if len(free) < 100:  # too few pool points to rank against
+                continue
+            ours.append(ranks_nd(free, x[:k], x[k]))
+            y = bridson_next_nd(x[:k], radius, rng)
+            if y is not None:
+                biased.append(ranks_nd(free, x[:k], y))
+    ours, biased = np.array(ours), np.array(biased)
+    assert len(ours) > 200 and len(biased) > 200, (len(ours), len(biased))
+    p_ours = [stats.kstest(ours[:, j], "uniform").pvalue for j in range(3)]
+    p_biased = [stats.kstest(biased[:, j], "uniform").pvalue for j in range(3)]
+    print(f"{dim}D: {len(ours)} ranks, KS p-values ours {p_ours}, Bridson {p_biased}")
+    assert min(p_ours) > 1e-3, p_ours
+    assert min(p_biased) < 1e-3, p_biased  # the same level rejects the biased variant
