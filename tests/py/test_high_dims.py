@@ -1,4 +1,4 @@
-"""9D to 16D: the guarantees of the low dimensions, checked by brute force on runs small enough
+"""7D to 16D: the guarantees of the low dimensions, checked by brute force on runs small enough
 for an exhaustive search (a unit box with radii of the order of its side: a few samples)."""
 import math
 
@@ -22,9 +22,10 @@ def assert_valid(x, r, rule, sizing, lo, hi, inhibition=1.0, periodic=None):
     assert rep.probes_max_rel <= 1e-9
 
 
-# (dim, radius): 9D and 11D split cells into 2^9 and 2^11 children, 13D into 32 blocks of 256,
-# 16D into 256 blocks
-@pytest.mark.parametrize("dim,radius", [(9, 1.5), (11, 2.0), (13, 2.5), (16, 3.0)])
+# (dim, radius): 7D and 8D (test_properties stops at 6D), 9D and 11D split
+# cells into 2^9 and 2^11 children, 13D into 32 blocks of 256, 16D into 256 blocks
+@pytest.mark.parametrize("dim,radius", [(7, 1.0), (8, 1.2), (9, 1.5), (11, 2.0), (13, 2.5),
+                                        (16, 3.0)])
 def test_uniform_radius(sample, dim, radius):
     x, r, t = sample(dim, "smaller", "const", radius, 40 + dim, 0.0, 1.0)
     assert_valid(x, r, "smaller", C.sizing_named("const", radius), np.zeros(dim), np.ones(dim))
