@@ -95,7 +95,7 @@ static vpds_status choose_index(vpdsi_mps *m, const vpdsi_ctx *ctx, int keep_tre
     vpdsi_run *run = &m->run;
     double reach = run->t * pb->inhibition * st->sizing.radius;
     st->grid_mode = 0;
-    if (st->sizing.kind == VPDSI_SIZING_CONSTANT && pb->dim <= 3 && !pb->two_radii &&
+    if (st->sizing.kind == VPDSI_SIZING_CONSTANT && pb->dim <= 4 && !pb->two_radii &&
         !pb->any_periodic && !keep_tree &&
         vpdsi_bgrid_setup(&st->grid, ctx->mem, pb->dim, run->geom.n0, pb->lo, run->geom.side0, reach) == 0 &&
         vpdsi_mem_reserve(ctx->mem, (void **)&m->cand, &m->cap_cand, st->grid.n_stencil + 1,
@@ -566,13 +566,22 @@ static vpds_status gather_near(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_store *st = ctx->st;
     double scale = m->run.t * (pb->two_radii ? pb->coverage : pb->inhibition);
-    m->n_cand = 0;
     if (st->grid_mode) {
         uint64_t base[VPDS_MAX_DIM];
         int k;
+        uint64_t at;
         for (k = 0; k < pb->dim; k++) base[k] = c[k] >> level; /* the base cell holding this one */
-        m->n_cand = vpdsi_bgrid_near(&st->grid, vpdsi_bgrid_index(&st->grid, base), m->cand);
-    } else if (!st->ogrid_mode) {
+        at = vpdsi_bgrid_index(&st->grid, base);
+        /* the cells of one base cell come one after another, and a sweep adds no sample: the
+         * list of the last one serves (in 4D its stencil reads 609 grid cells) */
+        if (m->cand_cell != at + 1) {
+            m->n_cand = vpdsi_bgrid_near(&st->grid, at, m->cand);
+            m->cand_cell = at + 1;
+        }
+        return VPDS_OK;
+    }
+    m->n_cand = 0;
+    if (!st->ogrid_mode) {
         vpdsi_kd_samples view = vpdsi_store_view(st);
         const vpdsi_near_list *near = near_lists(m, ctx, c, level, scale, r_hi);
         if (!near) goto oom;
@@ -830,6 +839,7 @@ static void begin_sweep(vpdsi_mps *m, const vpdsi_ctx *ctx, int split)
     m->run.pos = 0;
     m->unc.n_nwit = 0; /* the witness records of this sweep's flagged cells */
     m->strip.key = m->base.key = 0; /* new samples, and with a new scale new base cells */
+    m->cand_cell = 0;
 }
 
 /* One chunk of the sweep (or the filter) of at most limit cells; *done: work units spent. */
@@ -914,6 +924,7 @@ vpds_status vpdsi_mps_run(vpdsi_mps *m, const vpdsi_ctx *ctx, const vpdsi_work *
     uint64_t work = 0;
     vpds_status e = VPDS_OK;
     if (run->phase == VPDSI_DONE) return VPDS_OK;
+    m->cand_cell = 0; /* samples may have come between calls */
     if (run->phase == VPDSI_IDLE) {
         if ((e = setup(m, ctx, w->keep_tree)) != VPDS_OK) return e;
         if (run->phase == VPDSI_FILTER) begin_sweep(m, ctx, 0);

@@ -41,6 +41,7 @@ typedef struct vpdsi_near_list {
 typedef struct vpdsi_mps {
     vpdsi_run run;
     int32_t *cand; size_t n_cand, cap_cand; /* the samples near the cell being swept */
+    uint64_t cand_cell; /* background grid: 1 + the base cell cand was gathered around (0: none) */
     double *buf_x; size_t cap_buf_x;        /* a chunk's darts or cell centres */
     double *buf_r; size_t cap_buf_r;        /* r there */
     double *buf_u; size_t cap_buf_u;        /* weighted mode: the acceptance draw of each dart */
