@@ -5,10 +5,12 @@
 double vpdsi_lattice_box(const vpdsi_lattice *g, unsigned level, const uint64_t *c, double *lo,
                          double *hi)
 {
-    double diag2 = 0;
+    /* 2^-level, exact (levels stay far below 1022): the product is the correctly rounded
+     * side0 * 2^-level, as ldexp's, without d calls per box */
+    double diag2 = 0, shrink = ldexp(1.0, -(int)level);
     int k;
     for (k = 0; k < g->dim; k++) {
-        double side = ldexp(g->side0[k], -(int)level);
+        double side = g->side0[k] * shrink;
         uint64_t last = (g->n0[k] << level) - 1;
         lo[k] = g->lo[k] + (double)c[k] * side;
         hi[k] = c[k] == last ? g->hi[k] : g->lo[k] + (double)(c[k] + 1) * side;
