@@ -14,19 +14,37 @@ typedef struct {
     double d2;
 } stencil_entry;
 
+/* The stencil's reach in cells: the border's width (0: too wide for this grid). */
+static uint64_t span_of(int dim, const double *side, double reach)
+{
+    uint64_t span = 0;
+    int k;
+    for (k = 0; k < dim; k++) {
+        uint64_t sk = (uint64_t)floor(reach / side[k]) + 1;
+        if (sk > 8) return 0; /* not the grid this path is for */
+        if (sk > span) span = sk;
+    }
+    return span;
+}
+
+double vpdsi_bgrid_cells(int dim, const double *n, const double *side, double reach)
+{
+    double total = 1, span = (double)span_of(dim, side, reach);
+    int k;
+    if (span == 0) return 0;
+    for (k = 0; k < dim; k++) total *= n[k] + 2 * span;
+    return total;
+}
+
 int vpdsi_bgrid_setup(vpdsi_bgrid *g, vpdsi_mem *m, int dim, const uint64_t *n, const double *lo,
                       const double *side, double reach)
 {
-    uint64_t total = 1, span = 0;
+    uint64_t total = 1, span = span_of(dim, side, reach);
     int k, o[VPDS_MAX_DIM];
     size_t count = 0, i, j, cap_tmp = 0;
     stencil_entry *tmp = NULL;
     vpdsi_bgrid_release(g, m);
-    for (k = 0; k < dim; k++) {
-        uint64_t sk = (uint64_t)floor(reach / side[k]) + 1;
-        if (sk > 8) return -1; /* not the grid this path is for */
-        if (sk > span) span = sk;
-    }
+    if (span == 0) return -1;
     for (k = 0; k < dim; k++) {
         g->stride[k] = total;
         if (n[k] + 2 * span > ((uint64_t)INT32_MAX) / total) return -1;

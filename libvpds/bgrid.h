@@ -1,6 +1,6 @@
 /* Background grid for a uniform radius (Ebeida et al. 2012): cells of diagonal below the
  * conflict distance, so a cell holds at most one sample and a query scans a fixed stencil of
- * cells. Used instead of the kd-tree when every disk has the same radius and d <= 3. A border
+ * cells. Used instead of the kd-tree when every disk has the same radius and d <= 5. A border
  * of empty cells as wide as the stencil lets every query skip bounds checks. */
 #ifndef VPDS_BGRID_H
 #define VPDS_BGRID_H
@@ -19,6 +19,12 @@ typedef struct vpdsi_bgrid {
     size_t n_stencil, cap_stencil;
 } vpdsi_bgrid;
 
+/* Past 5D the stencil (some 20,000 cells in 6D) costs more than the kd-tree's queries. */
+#define VPDSI_BGRID_MAX_DIM 5
+
+/* Cells (border included) of a grid of n[k] cells of side side[k] per axis for reach; 0 past
+ * the stencil width setup accepts. */
+double vpdsi_bgrid_cells(int dim, const double *n, const double *side, double reach);
 /* Lay out over the base grid and empty it; reach is the conflict distance (>= the diagonal). */
 int vpdsi_bgrid_setup(vpdsi_bgrid *g, vpdsi_mem *m, int dim, const uint64_t *n, const double *lo,
                       const double *side, double reach);

@@ -52,6 +52,25 @@ static double bytes_per_sample(int d)
     return d <= 5 ? b[d] : 64.0 * d;
 }
 
+/* The background grid of a constant radius (mps.c's choose_index), one int32 per cell of the
+ * base grid and of its border. The fits above hold it in 1D-3D (measured with it); from 4D on
+ * they were measured with the kd-tree, and in 5D the border alone can be most of the peak
+ * (r = 0.4: 6^5 base cells, 12^5 with the border). */
+static double grid_bytes(const vpdsi_problem *pb, const vpdsi_store *st, double t, double side)
+{
+    double n[VPDS_MAX_DIM], sides[VPDS_MAX_DIM];
+    int k;
+    if (pb->dim < 4 || pb->dim > VPDSI_BGRID_MAX_DIM || st->sizing.kind != VPDSI_SIZING_CONSTANT ||
+        pb->two_radii || pb->any_periodic)
+        return 0;
+    for (k = 0; k < pb->dim; k++) { /* as mps.c lays out the base grid */
+        double ext = pb->hi[k] - pb->lo[k], cells = ceil(ext / side);
+        n[k] = cells < 1 ? 1 : cells;
+        sides[k] = ext / n[k];
+    }
+    return sizeof(int32_t) * vpdsi_bgrid_cells(pb->dim, n, sides, t * pb->inhibition * st->sizing.radius);
+}
+
 typedef struct probe_sums {
     double inv_ball, inv_cell; /* sums of 1 / V(t R_c / 2) and of 1 / side(r)^d */
     unsigned inside;
@@ -124,6 +143,7 @@ vpds_status vpdsi_estimate_run(const vpdsi_problem *pb, vpdsi_store *st, vpdsi_d
      * about as much again each, measured */
     if (pb->two_radii) out->bytes *= 2;
     if (dm->fn) out->bytes *= 2;
+    out->bytes += grid_bytes(pb, st, t, side);
     out->bytes += (double)fixed_bytes;
     return VPDS_OK;
 }

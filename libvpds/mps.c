@@ -86,8 +86,9 @@ static int grid_index_all(vpdsi_store *st, const vpdsi_problem *pb)
     return 0;
 }
 
-/* The background grid serves a uniform radius up to 5D (in 6D its stencil of some 20,000 cells
- * costs more than the kd-tree's queries: 1.47 s against 0.25 s at r = 0.6); the kd-tree everything else.
+/* The background grid serves a uniform radius up to VPDSI_BGRID_MAX_DIM (in 6D its stencil of
+ * some 20,000 cells cost more than the kd-tree's queries: 1.47 s against 0.25 s at r = 0.6);
+ * the kd-tree everything else.
  * (vpdsi_bgrid_setup releases the grid of an earlier scale; the kd-tree path releases it below.) */
 static vpds_status choose_index(vpdsi_mps *m, const vpdsi_ctx *ctx, int keep_tree)
 {
@@ -96,7 +97,7 @@ static vpds_status choose_index(vpdsi_mps *m, const vpdsi_ctx *ctx, int keep_tre
     vpdsi_run *run = &m->run;
     double reach = run->t * pb->inhibition * st->sizing.radius;
     st->grid_mode = 0;
-    if (st->sizing.kind == VPDSI_SIZING_CONSTANT && pb->dim <= 5 && !pb->two_radii &&
+    if (st->sizing.kind == VPDSI_SIZING_CONSTANT && pb->dim <= VPDSI_BGRID_MAX_DIM && !pb->two_radii &&
         !pb->any_periodic && !keep_tree &&
         vpdsi_bgrid_setup(&st->grid, ctx->mem, pb->dim, run->geom.n0, pb->lo, run->geom.side0, reach) == 0 &&
         vpdsi_mem_reserve(ctx->mem, (void **)&m->cand, &m->cap_cand, st->grid.n_stencil + 1,
