@@ -60,8 +60,9 @@ static double grid_bytes(const vpdsi_problem *pb, const vpdsi_store *st, double 
 {
     double n[VPDS_MAX_DIM], sides[VPDS_MAX_DIM];
     int k;
-    if (pb->dim < 4 || pb->dim > VPDSI_BGRID_MAX_DIM || st->sizing.kind != VPDSI_SIZING_CONSTANT ||
-        pb->two_radii || pb->any_periodic)
+    if (pb->dim < 4 ||
+        !vpdsi_bgrid_serves(pb->dim, st->sizing.kind == VPDSI_SIZING_CONSTANT, pb->two_radii,
+                            pb->any_periodic))
         return 0;
     for (k = 0; k < pb->dim; k++) { /* as mps.c lays out the base grid */
         double ext = pb->hi[k] - pb->lo[k], cells = ceil(ext / side);

@@ -86,9 +86,8 @@ static int grid_index_all(vpdsi_store *st, const vpdsi_problem *pb)
     return 0;
 }
 
-/* The background grid serves a uniform radius up to VPDSI_BGRID_MAX_DIM (in 6D its stencil of
- * some 20,000 cells cost more than the kd-tree's queries: 1.47 s against 0.25 s at r = 0.6);
- * the kd-tree everything else.
+/* The background grid serves a uniform radius where vpdsi_bgrid_serves says; the kd-tree
+ * everything else.
  * (vpdsi_bgrid_setup releases the grid of an earlier scale; the kd-tree path releases it below.) */
 static vpds_status choose_index(vpdsi_mps *m, const vpdsi_ctx *ctx, int keep_tree)
 {
@@ -97,8 +96,8 @@ static vpds_status choose_index(vpdsi_mps *m, const vpdsi_ctx *ctx, int keep_tre
     vpdsi_run *run = &m->run;
     double reach = run->t * pb->inhibition * st->sizing.radius;
     st->grid_mode = 0;
-    if (st->sizing.kind == VPDSI_SIZING_CONSTANT && pb->dim <= VPDSI_BGRID_MAX_DIM && !pb->two_radii &&
-        !pb->any_periodic && !keep_tree &&
+    if (vpdsi_bgrid_serves(pb->dim, st->sizing.kind == VPDSI_SIZING_CONSTANT, pb->two_radii,
+                           pb->any_periodic) && !keep_tree &&
         vpdsi_bgrid_setup(&st->grid, ctx->mem, pb->dim, run->geom.n0, pb->lo, run->geom.side0, reach) == 0 &&
         vpdsi_mem_reserve(ctx->mem, (void **)&m->cand, &m->cap_cand, st->grid.n_stencil + 1,
                           sizeof(int32_t)) == 0 &&
@@ -574,11 +573,12 @@ static vpds_status gather_near(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_
         uint64_t at;
         for (k = 0; k < pb->dim; k++) base[k] = c[k] >> level; /* the base cell holding this one */
         at = vpdsi_bgrid_index(&st->grid, base);
-        /* the cells of one base cell come one after another, and a sweep adds no sample: the
-         * list of the last one serves (in 4D its stencil reads 609 grid cells) */
-        if (m->cand_cell != at + 1) {
+        /* the cells of one base cell come one after another: its list serves them all while
+         * no sample comes (in 4D its stencil reads 609 grid cells), keyed as near_lists keys */
+        if (m->base.key != at + 1 || m->base.store_n != st->n) {
             m->n_cand = vpdsi_bgrid_near(&st->grid, at, m->cand);
-            m->cand_cell = at + 1;
+            m->base.key = at + 1;
+            m->base.store_n = st->n;
         }
         return VPDS_OK;
     }
@@ -850,7 +850,6 @@ static void begin_sweep(vpdsi_mps *m, const vpdsi_ctx *ctx, int split)
     m->run.pos = 0;
     m->unc.n_nwit = 0; /* the witness records of this sweep's flagged cells */
     m->strip.key = m->base.key = 0; /* new samples, and with a new scale new base cells */
-    m->cand_cell = 0;
 }
 
 /* One chunk of the sweep (or the filter) of at most limit cells; *done: work units spent. */
@@ -935,7 +934,6 @@ vpds_status vpdsi_mps_run(vpdsi_mps *m, const vpdsi_ctx *ctx, const vpdsi_work *
     uint64_t work = 0;
     vpds_status e = VPDS_OK;
     if (run->phase == VPDSI_DONE) return VPDS_OK;
-    m->cand_cell = 0; /* samples may have come between calls */
     if (run->phase == VPDSI_IDLE) {
         if ((e = setup(m, ctx, w->keep_tree)) != VPDS_OK) return e;
         if (run->phase == VPDSI_FILTER) begin_sweep(m, ctx, 0);

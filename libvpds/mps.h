@@ -41,12 +41,13 @@ typedef struct vpdsi_near_list {
 typedef struct vpdsi_mps {
     vpdsi_run run;
     int32_t *cand; size_t n_cand, cap_cand; /* the samples near the cell being swept */
-    uint64_t cand_cell; /* background grid: 1 + the base cell cand was gathered around (0: none) */
     double *buf_x; size_t cap_buf_x;        /* a chunk's darts or cell centres */
     double *buf_r; size_t cap_buf_r;        /* r there */
     double *buf_u; size_t cap_buf_u;        /* weighted mode: the acceptance draw of each dart */
     vpdsi_uncovered unc;                    /* two radii */
-    vpdsi_near_list strip, base;            /* the samples near the cells being swept */
+    vpdsi_near_list strip, base;            /* the samples near the cells being swept (the
+                                               background grid: base's key and store_n name
+                                               the base cell cand holds) */
 } vpdsi_mps;
 
 /* What one call may spend and whom it tells. */
