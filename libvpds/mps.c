@@ -43,6 +43,7 @@ void vpdsi_mps_release(vpdsi_mps *m, vpdsi_store *st)
 {
     vpdsi_mps_release_cells(m, st);
     vpdsi_mem_free(st->mem, m->cand, m->cap_cand * sizeof(int32_t));
+    vpdsi_mem_free(st->mem, m->cand_x, m->cap_cand_x * sizeof(double));
     vpdsi_mem_free(st->mem, m->strip.idx, m->strip.cap * sizeof(int32_t));
     vpdsi_mem_free(st->mem, m->base.idx, m->base.cap * sizeof(int32_t));
     memset(&m->strip, 0, sizeof m->strip);
@@ -52,8 +53,9 @@ void vpdsi_mps_release(vpdsi_mps *m, vpdsi_store *st)
     vpdsi_mem_free(st->mem, m->buf_u, m->cap_buf_u * sizeof(double));
     vpdsi_uncovered_release(&m->unc, st->mem);
     m->cand = NULL;
+    m->cand_x = NULL;
     m->buf_x = m->buf_r = m->buf_u = NULL;
-    m->cap_cand = m->cap_buf_x = m->cap_buf_r = m->cap_buf_u = 0;
+    m->cap_cand = m->cap_cand_x = m->cap_buf_x = m->cap_buf_r = m->cap_buf_u = 0;
 }
 
 /* Upper bound of the distance at which a sample of r <= r_hi covers at the run's scale. */
@@ -101,6 +103,8 @@ static vpds_status choose_index(vpdsi_mps *m, const vpdsi_ctx *ctx, int keep_tre
         vpdsi_bgrid_setup(&st->grid, ctx->mem, pb->dim, run->geom.n0, pb->lo, run->geom.side0, reach) == 0 &&
         vpdsi_mem_reserve(ctx->mem, (void **)&m->cand, &m->cap_cand, st->grid.n_stencil + 1,
                           sizeof(int32_t)) == 0 &&
+        vpdsi_mem_reserve(ctx->mem, (void **)&m->cand_x, &m->cap_cand_x,
+                          (st->grid.n_stencil + 1) * (size_t)pb->dim, sizeof(double)) == 0 &&
         grid_index_all(st, pb) == 0) {
         st->grid_mode = 1;
         return VPDS_OK;
@@ -374,6 +378,15 @@ static uint64_t child_number(unsigned block, unsigned j)
     return ((uint64_t)block << BLOCK_BITS) + j;
 }
 
+/* Whether bits 0 .. n - 1 of bits are all set (n up to BLOCK_CHILDREN). */
+static int children_all_set(const uint64_t *bits, unsigned n)
+{
+    unsigned w;
+    for (w = 0; w < n / 64; w++)
+        if (bits[w] != ~UINT64_C(0)) return 0;
+    return n % 64 == 0 || bits[n / 64] == (UINT64_C(1) << (n % 64)) - 1;
+}
+
 /* Which children of cell c in block `block` are covered whole by one candidate. A child's
  * farthest point from x is, on each axis, the farther end of its half; so per candidate all
  * children's squared farthest distances are sums of 2 values per axis, built child by child
@@ -416,6 +429,52 @@ static void children_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned 
             if (sums[b] <= f2) covered[b >> 6] |= UINT64_C(1) << (b & 63u);
         }
     }
+}
+
+/* The background grid's cells (one radius, open axes, up to 8D: one block): in one pass over
+ * the base cell's packed candidates, whether one disk holds cell c whole (1, as box_covered)
+ * and else which children are covered whole (as children_covered). The same bits as those two:
+ * on an axis the cell's farther end is the farther of its halves' (rounding is monotone), and
+ * the sums run in the same order. A pass stops once every child is covered: a later disk
+ * holding the whole cell would leave no child either. */
+static int packed_cover(const vpdsi_mps *m, int d, unsigned level, const uint64_t *c, double f,
+                        uint64_t *covered)
+{
+    unsigned children = 1u << d, b;
+    double lo[VPDS_MAX_DIM], mid[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], sums[BLOCK_CHILDREN], f2 = f * f;
+    uint64_t cc[VPDS_MAX_DIM] = {0};
+    size_t j;
+    int k;
+    for (k = 0; k < d; k++) cc[k] = 2 * c[k];
+    vpdsi_lattice_box(&m->run.geom, level + 1, cc, lo, mid);
+    for (k = 0; k < d; k++) cc[k] = 2 * c[k] + 1;
+    vpdsi_lattice_box(&m->run.geom, level + 1, cc, mid, hi);
+    if (!(f > 0)) return 0;
+    for (j = 0; j < m->n_cand; j++) {
+        const double *x = m->cand_x + j * (size_t)d;
+        double far[VPDS_MAX_DIM][2], least = 0, whole = 0;
+        for (k = 0; k < d; k++) {
+            double a = vpdsi_axis_far(x[k], lo[k], mid[k], 0.0);
+            double z = vpdsi_axis_far(x[k], mid[k], hi[k], 0.0);
+            far[k][0] = a * a;
+            far[k][1] = z * z;
+            least += far[k][0] < far[k][1] ? far[k][0] : far[k][1];
+            whole += far[k][0] > far[k][1] ? far[k][0] : far[k][1];
+        }
+        if (whole <= f2) return 1;
+        if (least > f2) continue; /* covers no child */
+        sums[0] = 0;
+        for (k = 0; k < d; k++) sums[0] += far[k][0];
+        if (sums[0] <= f2) covered[0] |= 1u;
+        for (b = 1; b < children; b++) {
+            unsigned bit = 0;
+            while (!((b >> bit) & 1u)) bit++;
+            sums[b] = sums[b & (b - 1)] - far[bit][0] + far[bit][1];
+            if (sums[b] <= f2) covered[b >> 6] |= UINT64_C(1) << (b & 63u);
+        }
+        if (children_all_set(covered, children)) break;
+    }
+    return 0;
 }
 
 /* Coordinates of child b of cell c (bit k of b: the upper half on axis k); without a split
@@ -576,7 +635,12 @@ static vpds_status gather_near(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_
         /* the cells of one base cell come one after another: its list serves them all while
          * no sample comes (in 4D its stencil reads 609 grid cells), keyed as near_lists keys */
         if (m->base.key != at + 1 || m->base.store_n != st->n) {
+            size_t j;
             m->n_cand = vpdsi_bgrid_near(&st->grid, at, m->cand);
+            /* packed once, read by every cell of the base cell (packed_cover) */
+            for (j = 0; j < m->n_cand; j++)
+                memcpy(m->cand_x + j * (size_t)pb->dim, st->x + (size_t)m->cand[j] * (size_t)pb->dim,
+                       (size_t)pb->dim * sizeof(double));
             m->base.key = at + 1;
             m->base.store_n = st->n;
         }
@@ -669,7 +733,7 @@ static vpds_status flag_uncovered(vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned l
 /* One block of a cell's children (or the cell itself): the uncovered ones into run->next. */
 static vpds_status sweep_block(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t *c, int split,
                                unsigned block, double r_lo, const double *centre, double phi,
-                               double h, int whole_c)
+                               double h, int whole_c, const uint64_t *known)
 {
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_run *run = &m->run;
@@ -679,7 +743,8 @@ static vpds_status sweep_block(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_
     uint64_t covered[4] = {0, 0, 0, 0}, cc[VPDS_MAX_DIM];
     uint8_t flag[BLOCK_CHILDREN]; /* two radii: the child may hold an uncovered point */
     vpds_status e;
-    if (split) children_covered(m, ctx, level, c, r_lo, scale, block, covered);
+    if (known) memcpy(covered, known, sizeof covered);
+    else if (split) children_covered(m, ctx, level, c, r_lo, scale, block, covered);
     if (ctx->dom->fn && phi > -0.5 * h &&
         (e = drop_outside_children(m, ctx, level, c, split, block, centre, phi, covered)) != VPDS_OK)
         return e;
@@ -714,6 +779,8 @@ static vpds_status sweep_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t
     double r_lo = need_r ? rc - L * h / 2 : st->sizing.radius;
     double r_hi = need_r ? rc + L * h / 2 : st->sizing.radius;
     size_t kept = run->next.count, records = m->unc.n_nwit;
+    uint64_t known[4] = {0, 0, 0, 0};
+    const uint64_t *pre = NULL; /* the children's bits when decided here */
     vpds_status e;
     if (ctx->dom->fn) {
         for (k = 0; k < d; k++) centre[k] = 0.5 * (lo[k] + hi[k]);
@@ -721,10 +788,15 @@ static vpds_status sweep_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t
         if (phi > 0.5 * h) return VPDS_OK; /* outside the domain, whole */
     }
     if ((e = gather_near(m, ctx, c, level, lo, hi, r_hi, split)) != VPDS_OK) return e;
-    if (box_covered(m, ctx, lo, hi, r_lo, scale)) return VPDS_OK;
+    if (st->grid_mode && split) { /* one radius, open axes, one block: one pass decides all */
+        if (packed_cover(m, d, level, c, scale * st->sizing.radius, known)) return VPDS_OK;
+        pre = known;
+    } else if (box_covered(m, ctx, lo, hi, r_lo, scale)) {
+        return VPDS_OK;
+    }
     if (pb->two_radii) whole_c = box_covered(m, ctx, lo, hi, r_lo, run->t * pb->coverage);
     for (block = 0; block < blocks; block++) {
-        if ((e = sweep_block(m, ctx, c, split, block, r_lo, centre, phi, h, whole_c)) != VPDS_OK) {
+        if ((e = sweep_block(m, ctx, c, split, block, r_lo, centre, phi, h, whole_c, pre)) != VPDS_OK) {
             run->next.count = kept;
             m->unc.n_nwit = records;
             return e;
