@@ -477,6 +477,27 @@ static int packed_cover(const vpdsi_mps *m, int d, unsigned level, const uint64_
     return 0;
 }
 
+/* The background grid: whether the sample filed in cell c's base cell holds c whole (as
+ * box_covered would find). Its cell's diagonal is below the reach, so it nearly always does,
+ * and the cell is dropped without reading the stencil. */
+static int occupant_covers(const vpdsi_ctx *ctx, unsigned level, const uint64_t *c,
+                           const double *lo, const double *hi, double f)
+{
+    const vpdsi_store *st = ctx->st;
+    uint64_t base[VPDS_MAX_DIM];
+    int d = ctx->pb->dim, k;
+    int32_t own;
+    double s = 0;
+    for (k = 0; k < d; k++) base[k] = c[k] >> level;
+    own = st->grid.cell[vpdsi_bgrid_index(&st->grid, base)];
+    if (own < 0 || !(f > 0)) return 0;
+    for (k = 0; k < d; k++) {
+        double e = vpdsi_axis_far(st->x[(size_t)own * (size_t)d + (size_t)k], lo[k], hi[k], 0.0);
+        s += e * e;
+    }
+    return s <= f * f;
+}
+
 /* Coordinates of child b of cell c (bit k of b: the upper half on axis k); without a split
  * the "child" is the cell itself. */
 static void child_coords(int d, const uint64_t *c, uint64_t b, int split, uint64_t *cc)
@@ -635,12 +656,11 @@ static vpds_status gather_near(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_
         /* the cells of one base cell come one after another: its list serves them all while
          * no sample comes (in 4D its stencil reads 609 grid cells), keyed as near_lists keys */
         if (m->base.key != at + 1 || m->base.store_n != st->n) {
-            size_t j;
+            size_t j, d = (size_t)pb->dim, k;
             m->n_cand = vpdsi_bgrid_near(&st->grid, at, m->cand);
             /* packed once, read by every cell of the base cell (packed_cover) */
             for (j = 0; j < m->n_cand; j++)
-                memcpy(m->cand_x + j * (size_t)pb->dim, st->x + (size_t)m->cand[j] * (size_t)pb->dim,
-                       (size_t)pb->dim * sizeof(double));
+                for (k = 0; k < d; k++) m->cand_x[j * d + k] = st->x[(size_t)m->cand[j] * d + k];
             m->base.key = at + 1;
             m->base.store_n = st->n;
         }
@@ -787,6 +807,7 @@ static vpds_status sweep_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t
         if ((e = vpdsi_domain_at(ctx->dom, st, centre, &phi)) != VPDS_OK) return e;
         if (phi > 0.5 * h) return VPDS_OK; /* outside the domain, whole */
     }
+    if (st->grid_mode && occupant_covers(ctx, level, c, lo, hi, scale * st->sizing.radius)) return VPDS_OK;
     if ((e = gather_near(m, ctx, c, level, lo, hi, r_hi, split)) != VPDS_OK) return e;
     if (st->grid_mode && split) { /* one radius, open axes, one block: one pass decides all */
         if (packed_cover(m, d, level, c, scale * st->sizing.radius, known)) return VPDS_OK;
