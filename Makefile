@@ -78,7 +78,7 @@ $(BUILD)/vpds.pc: libvpds/vpds.pc.in
 	@mkdir -p $(BUILD)
 	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' $< > $@
 
-$(BUILD)/tests/%: tests/%.c tests/check.h $(STATIC)
+$(BUILD)/tests/%: tests/%.c tests/check.h tests/failing_alloc.h $(STATIC)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_TEST) $< -o $@ $(STATIC) -lm -pthread
 

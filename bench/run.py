@@ -286,6 +286,17 @@ def fps_peer(dim: int, n: int) -> str:
     return f"fpsample bucket FPS ({n:,d} of {10 * n:,d} candidates): {sec:.2f} s, {n / sec:,.0f} samples/s"
 
 
+def python_progressive(dim: int, n: int, c_seconds: float) -> str:
+    """Python's progressive(n) on the stream's workload (radius 1, equal radii): the events
+    come from C in batches (vpds_next_n), so its time per sample is the C stream's."""
+    import vpds as lib
+    start = time.perf_counter()
+    res = lib.PoissonDisk(dim, radius=1.0, rng=1, progress=False).progressive(n, inhibition=None)
+    sec = time.perf_counter() - start
+    return (f"Python progressive({n:,d}): {sec:.2f} s, {len(res.points) / sec:,.0f} samples/s, "
+            f"{sec / c_seconds:.2f}x the C stream's time")
+
+
 def stream_rows() -> None:
     """The continuous stream (vpds_next) from empty: samples/s and the per-sample cost along n,
     beside a maximal run of about as many samples and beside a farthest-point sampler of a
@@ -305,6 +316,7 @@ def stream_rows() -> None:
         print("   us/sample per tenth of the stream: " + " ".join(f"{c:.0f}" for c in costs),
               flush=True)
         print("   beside " + fps_peer(dim, n), flush=True)
+        print("   " + python_progressive(dim, n, total), flush=True)
 
 
 if __name__ == "__main__":

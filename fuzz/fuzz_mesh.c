@@ -110,9 +110,24 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (mode & 2) {
         /* the stream: t never rises, each sample on its triangle and clear of the others */
         double x[3], t, last = INFINITY;
-        for (calls = 0; calls < 40 && (st = vpds_mesh_next(s, 0, x, &t)) == VPDS_OK; calls++) {
-            FUZZ_ASSERT(t <= last && !isnan(t), "stream t %g after %g", t, last);
-            last = t;
+        if (mode & 8) {
+            /* the 40 events in one call of vpds_mesh_next_n: written as stored, t never rising */
+            double xs[40 * 3], ts[40];
+            size_t got = 99, k;
+            st = vpds_mesh_next_n(s, 40, 0, xs, ts, &got);
+            FUZZ_ASSERT(got <= 40 && vpds_mesh_count(s) == got, "next_n: %zu events, %zu held", got,
+                        vpds_mesh_count(s));
+            for (k = 0; k < got; k++) {
+                FUZZ_ASSERT(ts[k] <= last && !isnan(ts[k]) && ts[k] == vpds_mesh_scales(s)[k] &&
+                            memcmp(xs + 3 * k, vpds_mesh_points(s) + 3 * k, sizeof x) == 0,
+                            "next_n: event %zu (t %g after %g)", k, ts[k], last);
+                last = t = ts[k];
+            }
+        } else {
+            for (calls = 0; calls < 40 && (st = vpds_mesh_next(s, 0, x, &t)) == VPDS_OK; calls++) {
+                FUZZ_ASSERT(t <= last && !isnan(t), "stream t %g after %g", t, last);
+                last = t;
+            }
         }
         check_status(st);
         FUZZ_ASSERT(st == VPDS_OK, "stream status %d: %s", (int)st, vpds_mesh_last_error(s));

@@ -56,10 +56,30 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         } else if (op == 3) {
             vpds_stats before = vpds_get_stats(s);
             double x[VPDS_MAX_DIM], t, prev = before.maximal ? before.t : INFINITY;
-            int m = 1 + take_u8(&b) % 40;
-            while (m-- > 0 && (st = vpds_next(s, 0, x, &t)) == VPDS_OK) {
-                FUZZ_ASSERT(t <= prev, "stream t rose: %g after %g", t, prev);
-                prev = t;
+            int m = 1 + take_u8(&b) % 40, batched = take_u8(&b) % 3;
+            if (batched) {
+                /* vpds_next_n: up to m events at once, into arrays or (batched == 2) none */
+                double xs[40 * VPDS_MAX_DIM], ts[40];
+                size_t got = 99, i, n0 = vpds_count(s);
+                double t_min = take_u8(&b) % 4 ? 0 : take_double(&b, 0.5, 2.0, 1);
+                st = vpds_next_n(s, (size_t)m, t_min, batched == 1 ? xs : NULL, batched == 1 ? ts : NULL, &got);
+                FUZZ_ASSERT(got <= (size_t)m && vpds_count(s) == n0 + got, "next_n: %zu events, count %zu -> %zu",
+                            got, n0, vpds_count(s));
+                FUZZ_ASSERT(st != VPDS_OK || got == (size_t)m, "next_n OK after %zu of %d events", got, m);
+                for (i = 0; i < got; i++) {
+                    double ti = vpds_scales(s)[n0 + i];
+                    FUZZ_ASSERT(ti <= prev && ti > t_min, "next_n: t %g after %g (t_min %g)", ti, prev, t_min);
+                    FUZZ_ASSERT(batched == 2 || (ts[i] == ti && memcmp(xs + i * (size_t)d.dim, vpds_points(s) +
+                                (n0 + i) * (size_t)d.dim, sizeof(double) * (size_t)d.dim) == 0),
+                                "next_n: event %zu written differs from the one stored", i);
+                    prev = ti;
+                }
+                if (st == VPDS_STREAM_END) st = VPDS_OK;
+            } else {
+                while (m-- > 0 && (st = vpds_next(s, 0, x, &t)) == VPDS_OK) {
+                    FUZZ_ASSERT(t <= prev, "stream t rose: %g after %g", t, prev);
+                    prev = t;
+                }
             }
             /* no event's farthest point lies further below its t than the domain's tolerance */
             FUZZ_ASSERT(vpds_get_stats(s).stream_slack <= VPDS_STREAM_DOMAIN_TOLERANCE * (1 + 1e-9),

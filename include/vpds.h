@@ -226,6 +226,13 @@ VPDS_API vpds_status vpds_run(vpds_sampler *sampler);
 VPDS_API vpds_status vpds_refine(vpds_sampler *sampler, double t);
 /* Continuous decrease (Section 4.2): one sample per call, t non-increasing. */
 VPDS_API vpds_status vpds_next(vpds_sampler *sampler, double t_min, double *x_out, double *t_out);
+/* Up to n events of vpds_next in one call, the same ones n calls give: the samples into x_out
+ * (n * dim doubles) and their t into t_out (n), either may be NULL (the samples are held by the
+ * sampler in any case: vpds_points); *count says how many were written. Returns VPDS_OK after n
+ * events, VPDS_STREAM_END when the next event's t would be at or below t_min, else the error of
+ * the event that failed: the events before it stay, as n calls of vpds_next leave them. */
+VPDS_API vpds_status vpds_next_n(vpds_sampler *sampler, size_t n, double t_min, double *x_out,
+                                 double *t_out, size_t *count);
 /* Fixed points (objects already placed): n points of dim doubles; r NULL: the sizing decides. */
 VPDS_API vpds_status vpds_add_points(vpds_sampler *sampler, const double *x, const double *r,
                                      size_t n);
@@ -577,6 +584,10 @@ VPDS_API vpds_status vpds_mesh_refine(vpds_mesh *mesh, double t);
  * vpds_mesh_refine goes below it. x_out: 3 doubles; face and barycentrics through
  * vpds_mesh_faces/_barycentrics. */
 VPDS_API vpds_status vpds_mesh_next(vpds_mesh *mesh, double t_min, double *x_out, double *t_out);
+/* Up to n events of vpds_mesh_next in one call, as vpds_next_n: x_out 3 * n doubles, t_out n,
+ * either may be NULL; *count written; the events before a failing one stay. */
+VPDS_API vpds_status vpds_mesh_next_n(vpds_mesh *mesh, size_t n, double t_min, double *x_out,
+                                      double *t_out, size_t *count);
 VPDS_API vpds_status vpds_mesh_set_budget(vpds_mesh *mesh, uint64_t budget);
 VPDS_API size_t vpds_mesh_count(const vpds_mesh *mesh);
 /* count * 3 coordinates; r; the scale t each sample was placed at. */

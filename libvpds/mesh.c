@@ -403,31 +403,66 @@ vpds_status vpds_mesh_refine(vpds_mesh *s, double t)
     return mesh_work(s);
 }
 
+/* The arguments every stream call shares (who calls says in `who`), and the state it starts
+ * from: empty, or a completed run. */
+static vpds_status mesh_stream_may_start(vpds_mesh *s, const char *who, double t_min)
+{
+    if (!(t_min >= 0) || t_min == INFINITY) {
+        vpdsi_store_error(&s->store, "%s: t_min = %g: must be finite and >= 0", who, t_min);
+        return VPDS_ERR_INVALID_ARGUMENT;
+    }
+    if (s->surface.phase != VPDSI_SURF_IDLE && s->surface.phase != VPDSI_SURF_DONE) {
+        vpdsi_store_error(&s->store, "%s: the run at scale %g is not finished; a stream starts "
+                          "from an empty mesh sampler or a maximal one (call vpds_mesh_run until "
+                          "VPDS_OK)", who, s->surface.t);
+        return VPDS_ERR_STATE;
+    }
+    return VPDS_OK;
+}
+
+/* One event of the surface stream (after mesh_stream_may_start). */
+static vpds_status mesh_stream_event(vpds_mesh *s, double t_min, double *x_out, double *t_out)
+{
+    vpdsi_surface_ctx c = mesh_context(s);
+    vpds_status e;
+    s->store.err[0] = 0;
+    e = vpdsi_surface_next(&s->stream, &c, t_min, s->run_t, x_out, t_out);
+    /* the samples are maximal at t (Section 4.2): a later refine goes below it */
+    if (e == VPDS_OK) vpdsi_surface_done_at(&s->surface, &s->mem, *t_out);
+    return e;
+}
+
 vpds_status vpds_mesh_next(vpds_mesh *s, double t_min, double *x_out, double *t_out)
 {
-    vpdsi_surface_ctx c;
     vpds_status e;
     if (!live(s)) return VPDS_ERR_INVALID_ARGUMENT;
     if (!x_out || !t_out) {
         vpdsi_store_error(&s->store, "vpds_mesh_next: x_out and t_out must not be NULL");
         return VPDS_ERR_INVALID_ARGUMENT;
     }
-    if (!(t_min >= 0) || t_min == INFINITY) {
-        vpdsi_store_error(&s->store, "vpds_mesh_next: t_min = %g: must be finite and >= 0", t_min);
+    if ((e = mesh_stream_may_start(s, "vpds_mesh_next", t_min)) != VPDS_OK) return e;
+    return mesh_stream_event(s, t_min, x_out, t_out);
+}
+
+vpds_status vpds_mesh_next_n(vpds_mesh *s, size_t n, double t_min, double *x_out, double *t_out,
+                             size_t *count)
+{
+    vpds_status e;
+    double x[3], t;
+    if (count) *count = 0;
+    if (!live(s)) return VPDS_ERR_INVALID_ARGUMENT;
+    if (!count) {
+        vpdsi_store_error(&s->store, "vpds_mesh_next_n: count must not be NULL (it says how many "
+                          "events were written)");
         return VPDS_ERR_INVALID_ARGUMENT;
     }
-    if (s->surface.phase != VPDSI_SURF_IDLE && s->surface.phase != VPDSI_SURF_DONE) {
-        vpdsi_store_error(&s->store, "vpds_mesh_next: the run at scale %g is not finished; a stream "
-                          "starts from an empty mesh sampler or a maximal one (call vpds_mesh_run "
-                          "until VPDS_OK)", s->surface.t);
-        return VPDS_ERR_STATE;
+    if ((e = mesh_stream_may_start(s, "vpds_mesh_next_n", t_min)) != VPDS_OK) return e;
+    for (; *count < n; (*count)++) {
+        if ((e = mesh_stream_event(s, t_min, x, &t)) != VPDS_OK) return e;
+        if (x_out) memcpy(x_out + 3 * *count, x, sizeof x);
+        if (t_out) t_out[*count] = t;
     }
-    c = mesh_context(s);
-    s->store.err[0] = 0;
-    e = vpdsi_surface_next(&s->stream, &c, t_min, s->run_t, x_out, t_out);
-    /* the samples are maximal at t (Section 4.2): a later refine goes below it */
-    if (e == VPDS_OK) vpdsi_surface_done_at(&s->surface, &s->mem, *t_out);
-    return e;
+    return VPDS_OK;
 }
 
 vpds_status vpds_mesh_set_budget(vpds_mesh *s, uint64_t budget)

@@ -170,29 +170,31 @@ vpds_status vpds_run(vpds_sampler *s)
     return vpdsi_sampler_run(s);
 }
 
-vpds_status vpds_next(vpds_sampler *s, double t_min, double *x_out, double *t_out)
+/* The arguments every stream call shares (who calls says in `who`), and the state it starts
+ * from: empty, or a completed run. */
+static vpds_status stream_may_start(vpds_sampler *s, const char *who, double t_min)
 {
-    vpdsi_run *run;
-    vpdsi_ctx c;
-    vpds_status st;
-    double t;
-    if (!vpdsi_sampler_live(s)) return VPDS_ERR_INVALID_ARGUMENT;
-    run = &s->mps.run;
-    s->store.err[0] = 0;
-    if (!x_out || !t_out) {
-        vpdsi_store_error(&s->store, "vpds_next: x_out and t_out must not be NULL");
-        return VPDS_ERR_INVALID_ARGUMENT;
-    }
+    const vpdsi_run *run = &s->mps.run;
     if (isnan(t_min)) {
-        vpdsi_store_error(&s->store, "vpds_next: t_min is NaN");
+        vpdsi_store_error(&s->store, "%s: t_min is NaN", who);
         return VPDS_ERR_INVALID_ARGUMENT;
     }
     if (run->phase != VPDSI_DONE && (run->phase != VPDSI_IDLE || vpdsi_store_has_samples(&s->store))) {
-        vpdsi_store_error(&s->store, "vpds_next: the run at scale %g is not finished; a stream "
-                          "starts from an empty sampler or a maximal one (call vpds_run until "
-                          "VPDS_OK)", run->t);
+        vpdsi_store_error(&s->store, "%s: the run at scale %g is not finished; a stream starts "
+                          "from an empty sampler or a maximal one (call vpds_run until VPDS_OK)",
+                          who, run->t);
         return VPDS_ERR_STATE;
     }
+    return VPDS_OK;
+}
+
+/* One event of the stream (after stream_may_start): the sample into x_out, its t into *t_out. */
+static vpds_status stream_event(vpds_sampler *s, double t_min, double *x_out, double *t_out)
+{
+    vpdsi_run *run = &s->mps.run;
+    vpdsi_ctx c;
+    vpds_status st;
+    double t;
     s->mem.limit_hit = 0;
     if ((st = ensure_rmax(s)) != VPDS_OK) return vpdsi_sampler_note_limit(s, st);
     c = context(s);
@@ -205,6 +207,43 @@ vpds_status vpds_next(vpds_sampler *s, double t_min, double *x_out, double *t_ou
     run->phase = VPDSI_DONE;
     run->t = t;
     s->stats.t = t;
+    return VPDS_OK;
+}
+
+vpds_status vpds_next(vpds_sampler *s, double t_min, double *x_out, double *t_out)
+{
+    vpds_status st;
+    if (!vpdsi_sampler_live(s)) return VPDS_ERR_INVALID_ARGUMENT;
+    s->store.err[0] = 0;
+    if (!x_out || !t_out) {
+        vpdsi_store_error(&s->store, "vpds_next: x_out and t_out must not be NULL");
+        return VPDS_ERR_INVALID_ARGUMENT;
+    }
+    if ((st = stream_may_start(s, "vpds_next", t_min)) != VPDS_OK) return st;
+    return stream_event(s, t_min, x_out, t_out);
+}
+
+vpds_status vpds_next_n(vpds_sampler *s, size_t n, double t_min, double *x_out, double *t_out,
+                        size_t *count)
+{
+    vpds_status st;
+    double x[VPDS_MAX_DIM], t;
+    size_t d;
+    if (count) *count = 0;
+    if (!vpdsi_sampler_live(s)) return VPDS_ERR_INVALID_ARGUMENT;
+    s->store.err[0] = 0;
+    if (!count) {
+        vpdsi_store_error(&s->store, "vpds_next_n: count must not be NULL (it says how many "
+                          "events were written)");
+        return VPDS_ERR_INVALID_ARGUMENT;
+    }
+    if ((st = stream_may_start(s, "vpds_next_n", t_min)) != VPDS_OK) return st;
+    d = (size_t)s->pb.dim;
+    for (; *count < n; (*count)++) {
+        if ((st = stream_event(s, t_min, x, &t)) != VPDS_OK) return st;
+        if (x_out) memcpy(x_out + *count * d, x, d * sizeof *x);
+        if (t_out) t_out[*count] = t;
+    }
     return VPDS_OK;
 }
 

@@ -3,6 +3,7 @@
  * or refine and for stream prefixes {x_k : t_k >= tau}; determinism by seed; fixed points;
  * allocation failures during a stream leave a state that resumes to the same points. */
 #include "check.h"
+#include "failing_alloc.h"
 #include "vpds.h"
 #include "rules.h"
 #include <math.h>
@@ -23,22 +24,6 @@ static double wave(const double *x, void *u)
     return 0.03 + 0.01 * sin(2 * 3.14159265358979323846 * x[0]);
 }
 
-/* An allocator that fails its fail_at-th call (0: never) and counts the bytes it holds. */
-typedef struct {
-    size_t calls, fail_at, live;
-} failing_alloc;
-static void *fa_alloc(size_t size, void *u)
-{
-    failing_alloc *a = (failing_alloc *)u;
-    if (++a->calls == a->fail_at) return NULL;
-    a->live += size;
-    return malloc(size);
-}
-static void fa_free(void *p, size_t size, void *u)
-{
-    ((failing_alloc *)u)->live -= size;
-    free(p);
-}
 
 typedef struct {
     int dim;

@@ -178,6 +178,23 @@ def test_progressive_exactly_n(domain):
     assert len(e.points) == 0  # the sampler itself is untouched
 
 
+def test_progressive_is_the_stream_across_batches():
+    """progressive(n) takes its events from C in batches of vpds_next_n: past several batch
+    boundaries they are the events of stream(), one C call each, bit for bit."""
+    from vpds._core import STREAM_BATCH
+    n = 2 * STREAM_BATCH + 17
+    batched = vpds.PoissonDisk(2, radius=0.005, rng=4, progress=False).progressive(n, inhibition=None)
+    one_by_one = vpds.PoissonDisk(2, radius=0.005, rng=4, progress=False)
+    pts, ts = [], []
+    for x, t in one_by_one.stream():
+        pts.append(x)
+        ts.append(t)
+        if len(pts) == n:
+            break
+    np.testing.assert_array_equal(batched.points, np.array(pts))
+    np.testing.assert_array_equal(batched.scales, np.array(ts))
+
+
 def test_progressive_first_points_are_random():
     """With equal radii the second point is a corner (farthest from the first); the default
     R_f = 0.5 R_c keeps the first points random."""

@@ -41,6 +41,9 @@ MAX_DIM: int = int(lib.VPDS_MAX_DIM)
 # work units (darts + cells) per C call in a fill: small enough for a responsive Ctrl-C and
 # progress bar, large enough that the calls cost nothing measurable
 _CHUNK = 50_000
+# events of the stream per call of vpds_next_n (progressive): one C call for many events, and
+# Ctrl-C still answered between calls
+STREAM_BATCH = 4096
 #: what `sizing` takes: a radius, a grid of radii (d axes), a SizingGrid, r(x), an EXR image path
 SizingLike = Union[None, float, npt.ArrayLike, SizingGrid, SizingFunction, str, os.PathLike[str]]
 
@@ -541,10 +544,13 @@ class PoissonDisk:
             desc.inhibition = float(inhibition) * desc.coverage
         s = self._new_sampler(desc)
         first = int(lib.vpds_count(s))
-        x = ffi.new("double[]", self.d)
-        t = ffi.new("double *")
-        for _ in range(n):
-            if self._check(lib.vpds_next(s, 0.0, x, t), s) == lib.VPDS_STREAM_END:
+        got = ffi.new("size_t *")
+        left = n
+        while left > 0:
+            # batches of vpds_next_n (the events of one call each), so Ctrl-C stops between them
+            st = self._check(lib.vpds_next_n(s, min(left, STREAM_BATCH), 0.0, ffi.NULL, ffi.NULL, got), s)
+            left -= int(got[0])
+            if st == lib.VPDS_STREAM_END:
                 break
         count = int(lib.vpds_count(s))
         pts = np.frombuffer(ffi.buffer(lib.vpds_points(s), count * self.d * 8),

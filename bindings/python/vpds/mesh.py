@@ -20,7 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ._callbacks import take, raise_failure
-from ._core import RULES, _CHUNK, _algorithm_version
+from ._core import RULES, STREAM_BATCH, _CHUNK, _algorithm_version
 from ._errors import _raise, created
 from ._scipy_compat import _seed_from
 from ._typing import RngLike, SizingFunction
@@ -148,10 +148,13 @@ class MeshSampler:
         at scales up to the run's; after the stream, `refine(t)` goes below its last scale."""
         if not isinstance(n, (int, np.integer)) or isinstance(n, bool) or n < 0:
             raise ValueError(f"n = {n!r}: must be an int >= 0")
-        x = ffi.new("double[3]")
-        t = ffi.new("double *")
+        got = ffi.new("size_t *")
         while int(lib.vpds_mesh_count(self._m)) < n:
-            self._check(lib.vpds_mesh_next(self._m, 0.0, x, t))
+            # batches of vpds_mesh_next_n, so Ctrl-C stops between them
+            left = n - int(lib.vpds_mesh_count(self._m))
+            if self._check(lib.vpds_mesh_next_n(self._m, min(left, STREAM_BATCH), 0.0, ffi.NULL, ffi.NULL,
+                                                got)) == lib.VPDS_STREAM_END:
+                break
         return self.samples
 
     @property
