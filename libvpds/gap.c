@@ -139,10 +139,32 @@ static int popcount(unsigned v)
     return c;
 }
 
-double vpdsi_gap_max(int d, const double *lo, const double *hi, unsigned faces, const double *p,
-                     int n, double *y)
+/* The faces (of those in `faces`) no single point holds within floor: on a face whose every
+ * corner lies within floor of one point, the ball being convex, no vertex can exceed floor (the
+ * margin covers round-off). far2[i]: point i's farthest corner of the box. */
+static unsigned uncovered_faces(int d, const double *h, const double *q, const double *far2, int n,
+                                double floor)
 {
-    double c[D], h[D], q[VPDSI_GAP_MAX_POINTS * D], A[D][D] = {{0}}, b[D] = {0};
+    unsigned open = 0;
+    int k, side, i;
+    if (!(floor > 0)) return ~0u;
+    for (k = 0; k < d; k++)
+        for (side = 0; side < 2; side++) {
+            int held = 0;
+            for (i = 0; i < n && !held; i++) {
+                double qk = q[i * D + k], across = fabs(qk) + h[k], to = side ? h[k] - qk : -h[k] - qk;
+                held = (far2[i] - across * across + to * to) * (1 + 1e-9) <= floor;
+            }
+            if (!held) open |= 1u << (2 * k + side);
+        }
+    return open;
+}
+
+double vpdsi_gap_max_above(int d, const double *lo, const double *hi, unsigned faces,
+                           const double *p, int n, double floor, double *y)
+{
+    double c[D], h[D], q[VPDSI_GAP_MAX_POINTS * D], far2[VPDSI_GAP_MAX_POINTS], A[D][D] = {{0}};
+    double b[D] = {0};
     gap_search g;
     unsigned mask, axes;
     int i, k, usable[1 << D], any[D + 2] = {0};
@@ -150,14 +172,20 @@ double vpdsi_gap_max(int d, const double *lo, const double *hi, unsigned faces, 
         c[k] = 0.5 * (lo[k] + hi[k]);
         h[k] = 0.5 * (hi[k] - lo[k]);
     }
-    for (i = 0; i < n; i++)
-        for (k = 0; k < d; k++) q[i * D + k] = p[i * d + k] - c[k];
+    for (i = 0; i < n; i++) {
+        far2[i] = 0;
+        for (k = 0; k < d; k++) {
+            q[i * D + k] = p[i * d + k] - c[k];
+            far2[i] += (fabs(q[i * D + k]) + h[k]) * (fabs(q[i * D + k]) + h[k]);
+        }
+    }
+    faces &= uncovered_faces(d, h, q, far2, n, floor);
     g.d = d;
     g.n = n;
     g.faces = faces;
     g.h = h;
     g.q = q;
-    g.best = -1;
+    g.best = floor;
     memset(g.y, 0, sizeof g.y);
     /* the free axes of a vertex: each other axis needs an allowed face; most pieces of a
      * search have none, and only the interior vertices (m = d + 1) remain */
@@ -178,11 +206,18 @@ double vpdsi_gap_max(int d, const double *lo, const double *hi, unsigned faces, 
         for (axes = 0; axes < (1u << d); axes++)
             if (usable[axes] && popcount(axes) == m - 1) vertices(&g, m, axes, A, b);
     }
+    if (!(g.best > floor)) return -1;
     for (k = 0; k < d; k++) {
         double v = c[k] + g.y[k];
         y[k] = v < lo[k] ? lo[k] : v > hi[k] ? hi[k] : v;
     }
     return g.best;
+}
+
+double vpdsi_gap_max(int d, const double *lo, const double *hi, unsigned faces, const double *p,
+                     int n, double *y)
+{
+    return vpdsi_gap_max_above(d, lo, hi, faces, p, n, -1, y);
 }
 
 int vpdsi_gap_dominated(int dim, const double *lo, const double *hi, const double *pi,

@@ -19,6 +19,11 @@
 double vpdsi_gap_max(int dim, const double *lo, const double *hi, unsigned faces, const double *p,
                      int n, double *y);
 
+/* vpdsi_gap_max among the vertices whose gap exceeds floor: the same answer when it does, else
+ * -1 and y untouched (a search passes the best it holds, and most subsets are skipped). */
+double vpdsi_gap_max_above(int dim, const double *lo, const double *hi, unsigned faces,
+                           const double *p, int n, double floor, double *y);
+
 /* Whether p_j is nowhere in the box nearer than p_i: |y - p_i| < |y - p_j| for every y in it
  * (the difference of squares is linear in y, so its largest value over the box is per axis). */
 int vpdsi_gap_dominated(int dim, const double *lo, const double *hi, const double *pi,

@@ -83,7 +83,7 @@ static int search_box(gap_box_search *q, const double *lo, const double *hi, uns
     if (n <= points_per_box(d) || (depth + 1 == VPDSI_GAP_SEARCH_DEPTH && n <= VPDSI_GAP_MAX_POINTS)) {
         double v;
         for (i = 0; i < n; i++) memcpy(pts + i * d, q->p + (size_t)out[i] * d, (size_t)d * sizeof(double));
-        v = vpdsi_gap_max(d, lo, hi, faces, pts, n, y);
+        v = vpdsi_gap_max_above(d, lo, hi, faces, pts, n, q->best, y);
         if (v > q->best) {
             q->best = v;
             memcpy(q->y, y, (size_t)d * sizeof(double));

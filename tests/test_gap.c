@@ -1,6 +1,7 @@
 /* The exact largest gap (gap.c) and the version-5 stream built on it, against brute force:
  * - vpdsi_gap_max: the point it returns is in the box and has the gap it reports, and no probe
  *   of the box (random ones, a grid, the corners) has a larger gap;
+ * - vpdsi_gap_max_above: below the maximum the same bits as vpdsi_gap_max, at it nothing;
  * - vpdsi_gap_dominated: never says "dominated" where some probe is nearer the dominated point;
  * - the stream with one radius: each event's t is the gap of its point before it was inserted
  *   (to round-off: the point is the farthest point, not one within the tolerance), and no probe
@@ -33,6 +34,25 @@ static double nearest2(int d, const double *p, int n, const double *y)
     return best;
 }
 
+/* vpdsi_gap_max_above against vpdsi_gap_max's answer v, y: below v (floors that hold most
+ * faces, and none) the same bits; at v and above, -1 and y untouched. */
+static void check_floors(int d, const double *lo, const double *hi, unsigned faces, const double *p,
+                         int n, double v, const double *y)
+{
+    static const double below[4] = {0.999999, 0.99, 0.8, 0.3};
+    double fy[4], w;
+    int j;
+    for (j = 0; j < 4 && v > 0; j++) {
+        memset(fy, 0, sizeof fy);
+        w = vpdsi_gap_max_above(d, lo, hi, faces, p, n, v * below[j], fy);
+        CHECK_MSG(w == v && memcmp(fy, y, (size_t)d * sizeof(double)) == 0,
+                  "d %d n %d: floor %.17g gives %.17g, no floor %.17g", d, n, v * below[j], w, v);
+    }
+    for (j = 0; j < 4; j++) fy[j] = 7;
+    w = vpdsi_gap_max_above(d, lo, hi, faces, p, n, v < 0 ? 0 : v, fy);
+    CHECK(w == -1 && fy[0] == 7 && fy[d - 1] == 7);
+}
+
 /* One random configuration: a box and n points (some outside it), checked by probes. */
 static void check_gap_once(int d, int n, int probes)
 {
@@ -45,6 +65,7 @@ static void check_gap_once(int d, int n, int probes)
     for (i = 0; i < n; i++)
         for (k = 0; k < d; k++) p[i * d + k] = lo[k] - 0.5 + unit() * (hi[k] - lo[k] + 1);
     v = vpdsi_gap_max(d, lo, hi, VPDSI_GAP_ALL_FACES(d), p, n, y);
+    check_floors(d, lo, hi, VPDSI_GAP_ALL_FACES(d), p, n, v, y);
     for (k = 0; k < d; k++) inside &= y[k] >= lo[k] && y[k] <= hi[k];
     CHECK(inside);
     CHECK_MSG(fabs(nearest2(d, p, n, y) - v) <= 1e-12 * v, "d %d n %d: gap at y %.17g, reported %.17g",
@@ -80,6 +101,7 @@ static void check_gap_once(int d, int n, int probes)
                 holds &= y[k] >= plo[k] && y[k] <= phi[k];
             }
             pv = vpdsi_gap_max(d, plo, phi, faces, p, n, py);
+            check_floors(d, plo, phi, faces, p, n, pv, py);
             CHECK(pv <= v * (1 + 1e-12));
             if (pv >= 0) CHECK(fabs(nearest2(d, p, n, py) - pv) <= 1e-12 * pv);
             if (holds && pv > found) found = pv;
