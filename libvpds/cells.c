@@ -5,10 +5,12 @@
 double vpdsi_lattice_box(const vpdsi_lattice *g, unsigned level, const uint64_t *c, double *lo,
                          double *hi)
 {
-    /* 2^-level, exact (levels stay far below 1022): the product is the correctly rounded
-     * side0 * 2^-level, as ldexp's, without d calls per box */
-    double diag2 = 0, shrink = ldexp(1.0, -(int)level);
+    /* 2^-level, exact (levels stay far below 1022), made from its exponent bits rather than
+     * a call of ldexp per box: the product is the correctly rounded side0 * 2^-level */
+    uint64_t bits = (uint64_t)(1023 - level) << 52;
+    double diag2 = 0, shrink;
     int k;
+    memcpy(&shrink, &bits, sizeof shrink);
     for (k = 0; k < g->dim; k++) {
         double side = g->side0[k] * shrink;
         uint64_t last = (g->n0[k] << level) - 1;
