@@ -25,11 +25,12 @@
 void vpdsi_stream_init(vpdsi_stream *sm)
 {
     memset(sm, 0, sizeof *sm);
+    vpdsi_region_heap_init(&sm->regions, 0);
 }
 
 void vpdsi_stream_release(vpdsi_stream *sm, vpdsi_mem *m)
 {
-    vpdsi_mem_free(m, sm->heap, sm->cap * sizeof(uint64_t));
+    vpdsi_region_heap_release(&sm->regions, m);
     vpdsi_mem_free(m, sm->boxes, sm->cap_boxes * sizeof(double));
     vpdsi_mem_free(m, sm->buf, sm->cap_buf * sizeof(double));
     vpdsi_mem_free(m, sm->kids, sm->cap_kids * sizeof(double));
@@ -41,9 +42,9 @@ void vpdsi_stream_release(vpdsi_stream *sm, vpdsi_mem *m)
     vpdsi_stream_init(sm);
 }
 
-/* ---- the region heap: records of (key, level, coordinates) ---- */
+/* ---- the region heap (region_heap.h): records of (key, level, g at the cached maximiser,
+ * coordinates, maximiser) ---- */
 
-/* key, level, g at the cached maximiser (-1: none), coordinates[dim], maximiser[dim] */
 static size_t rec_words(const vpdsi_stream *sm) { return 3 + 2 * (size_t)sm->geom.dim; }
 #define REC_COORD 3
 
@@ -54,7 +55,7 @@ static double rec_key(const uint64_t *r)
     return k;
 }
 
-/* Swaps two records of w 8-byte words (the region heap's uint64_t, the box heap's doubles). */
+/* Swaps two records of w 8-byte words (the search's box heap of doubles). */
 static void words_swap(void *a, void *b, size_t w)
 {
     unsigned char *p = (unsigned char *)a, *q = (unsigned char *)b;
@@ -68,49 +69,41 @@ static void words_swap(void *a, void *b, size_t w)
     }
 }
 
-/* Push (after a reserve): sift up. */
+/* Push (after a reserve); y NULL: no cached maximiser (gy < 0), its words zero. */
 static void heap_push(vpdsi_stream *sm, double key, uint64_t level, const uint64_t *c, double gy,
                       const double *y)
 {
     int d = sm->geom.dim;
-    size_t w = rec_words(sm), i = sm->count++;
-    uint64_t *r = sm->heap + i * w;
-    memcpy(r, &key, sizeof key);
-    r[1] = level;
-    memcpy(r + 2, &gy, sizeof gy);
-    memcpy(r + REC_COORD, c, (size_t)d * sizeof(uint64_t));
-    if (y) memcpy(r + REC_COORD + d, y, (size_t)d * sizeof(double));
-    while (i > 0) {
-        size_t p = (i - 1) / 2;
-        if (!(rec_key(sm->heap + p * w) < rec_key(sm->heap + i * w))) break;
-        words_swap(sm->heap + p * w, sm->heap + i * w, w);
-        i = p;
-    }
+    uint64_t body[1 + 2 * VPDS_MAX_DIM];
+    memcpy(body, &gy, sizeof gy);
+    memcpy(body + 1, c, (size_t)d * sizeof(uint64_t));
+    if (y) memcpy(body + 1 + d, y, (size_t)d * sizeof(double));
+    else memset(body + 1 + d, 0, (size_t)d * sizeof(uint64_t));
+    vpdsi_region_heap_push(&sm->regions, key, (unsigned)level, body);
 }
 
-/* Remove the top into out (w words). */
+/* Remove the top into out (rec_words words). */
 static void heap_pop(vpdsi_stream *sm, uint64_t *out)
 {
-    size_t w = rec_words(sm), i = 0, n;
-    memcpy(out, sm->heap, w * sizeof(uint64_t));
-    n = --sm->count;
-    if (n == 0) return;
-    memcpy(sm->heap, sm->heap + n * w, w * sizeof(uint64_t));
-    for (;;) {
-        size_t l = 2 * i + 1, r = l + 1, m = i;
-        if (l < n && rec_key(sm->heap + l * w) > rec_key(sm->heap + m * w)) m = l;
-        if (r < n && rec_key(sm->heap + r * w) > rec_key(sm->heap + m * w)) m = r;
-        if (m == i) break;
-        words_swap(sm->heap + m * w, sm->heap + i * w, w);
-        i = m;
-    }
+    double key;
+    unsigned level;
+    vpdsi_region_heap_pop(&sm->regions, &key, &level, out + 2);
+    memcpy(out, &key, sizeof key);
+    out[1] = level;
+}
+
+/* The top record into out, the heap unchanged. */
+static void heap_top(const vpdsi_stream *sm, uint64_t *out)
+{
+    double key = vpdsi_region_heap_key(&sm->regions, 0);
+    memcpy(out, &key, sizeof key);
+    out[1] = vpdsi_region_heap_top_level(&sm->regions);
+    memcpy(out + 2, vpdsi_region_heap_top(&sm->regions), (rec_words(sm) - 2) * sizeof(uint64_t));
 }
 
 static int heap_reserve(vpdsi_stream *sm, vpdsi_mem *mem, size_t more)
 {
-    size_t words;
-    if (vpdsi_mul_size(sm->count + more, rec_words(sm), &words)) return -1;
-    return vpdsi_mem_reserve(mem, (void **)&sm->heap, &sm->cap, words, sizeof(uint64_t));
+    return vpdsi_region_heap_reserve(&sm->regions, mem, more);
 }
 
 /* Box of a region as centre and half sides; the last region of an axis ends at the face. */
@@ -151,6 +144,7 @@ static vpds_status build_regions(vpdsi_stream *sm, const vpdsi_ctx *ctx)
         unsigned cap = 62 - vpdsi_bit_length(sm->geom.n0[k]);
         if (cap < sm->max_level) sm->max_level = cap;
     }
+    sm->regions.words = rec_words(sm) - 2;
     if (heap_reserve(sm, ctx->mem, (size_t)total)) {
         vpdsi_store_error(ctx->st, "out of memory for %llu stream regions", (unsigned long long)total);
         return VPDS_ERR_OUT_OF_MEMORY;
@@ -918,20 +912,20 @@ vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_m
         double key, next, centre[VPDS_MAX_DIM], half[VPDS_MAX_DIM], bound = 0, y[VPDS_MAX_DIM], gy;
         double t = 0, x[VPDS_MAX_DIM], rx = 0, step_lb;
         int split, event;
-        size_t w = rec_words(sm);
-        key = rec_key(sm->heap);
+        key = vpdsi_region_heap_key(&sm->regions, 0);
         if (key <= t_min) return VPDS_STREAM_END; /* every region is below: nothing consumed */
         if (heap_reserve(sm, ctx->mem, (size_t)1 << d) || reserve_kids(sm, ctx->mem)) {
             vpdsi_store_error(st, "out of memory for the stream's regions");
             return VPDS_ERR_OUT_OF_MEMORY;
         }
-        memcpy(rec, sm->heap, w * sizeof(uint64_t));
+        heap_top(sm, rec);
         memcpy(&gy, rec + 2, sizeof gy);
         memcpy(y, rec + REC_COORD + d, (size_t)d * sizeof(double));
         /* the largest key below the top's: one of its children's (the key the top would
          * have after a pop) */
-        next = sm->count > 1 ? rec_key(sm->heap + w) : 0.0;
-        if (sm->count > 2 && rec_key(sm->heap + 2 * w) > next) next = rec_key(sm->heap + 2 * w);
+        next = sm->regions.count > 1 ? vpdsi_region_heap_key(&sm->regions, 1) : 0.0;
+        if (sm->regions.count > 2 && vpdsi_region_heap_key(&sm->regions, 2) > next)
+            next = vpdsi_region_heap_key(&sm->regions, 2);
         region_box(sm, (unsigned)rec[1], rec + REC_COORD, centre, half);
         if ((e = split_if_coarse(sm, ctx, rec, centre, half, t_cap, &split)) != VPDS_OK) return e;
         if (split) continue;

@@ -3,6 +3,7 @@
 #define VPDS_STREAM_H
 #include "cells.h"
 #include "context.h"
+#include "region_heap.h"
 
 /* The box is cut into regions (cells of a lazily refined grid) in a max-heap keyed by an upper
  * bound of g = distance to the samples over coverage * f, the scale at which a point becomes
@@ -11,8 +12,8 @@ typedef struct vpdsi_stream {
     int active;                    /* regions built */
     vpdsi_lattice geom;            /* level-0 regions and their boxes */
     unsigned max_level;
-    uint64_t *heap;                /* records of 2 + dim words: key (double), level, coordinates */
-    size_t count, cap;
+    vpdsi_region_heap regions;     /* records: key; level, g at the cached maximiser,
+                                      coordinates[dim], maximiser[dim] */
     double *boxes;                 /* the search inside one region: key, centre, half sides */
     size_t n_boxes, cap_boxes;
     double *buf;                   /* centres and radii of one split */

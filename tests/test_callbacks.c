@@ -134,7 +134,7 @@ static progress_t progress_of(const vpds_sampler *s)
     progress_t p;
     memset(&p, 0, sizeof p);
     p.n = s->store.n;
-    p.heap = s->stream.count;
+    p.heap = s->stream.regions.count;
     p.darts = s->stats.darts;
     p.pos = s->mps.run.pos;
     p.vpos = s->mps.run.vpos;
