@@ -459,8 +459,9 @@ static vpds_status search_diverged(const vpdsi_ctx *ctx, const double *centre)
  * samples that can be nearest in it is a vertex of their bisectors (gap.c, gap_search.c). */
 static int exact_applies(const vpdsi_ctx *ctx)
 {
+    int top = ctx->pb->algorithm >= 9 ? VPDSI_GAP_MAX_DIM : VPDSI_GAP_V5_MAX_DIM;
     return ctx->pb->algorithm >= 5 && ctx->st->sizing.kind == VPDSI_SIZING_CONSTANT &&
-           !ctx->dom->fn && ctx->pb->dim <= VPDSI_GAP_MAX_DIM;
+           !ctx->dom->fn && ctx->pb->dim <= top;
 }
 
 #define EXACT_MAX_IMAGES 4096 /* candidate images one region takes; past it, the search */

@@ -14,6 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define GD VPDSI_GAP_MAX_DIM /* coordinates of one point, at most */
+
 static int quick; /* VPDS_TEST_QUICK (valgrind): fewer configurations */
 static unsigned long long rng_state = 12345;
 static double unit(void)
@@ -40,7 +42,7 @@ static void check_floors(int d, const double *lo, const double *hi, unsigned fac
                          int n, double v, const double *y)
 {
     static const double below[4] = {0.999999, 0.99, 0.8, 0.3};
-    double fy[4], w;
+    double fy[GD], w;
     int j;
     for (j = 0; j < 4 && v > 0; j++) {
         memset(fy, 0, sizeof fy);
@@ -48,7 +50,7 @@ static void check_floors(int d, const double *lo, const double *hi, unsigned fac
         CHECK_MSG(w == v && memcmp(fy, y, (size_t)d * sizeof(double)) == 0,
                   "d %d n %d: floor %.17g gives %.17g, no floor %.17g", d, n, v * below[j], w, v);
     }
-    for (j = 0; j < 4; j++) fy[j] = 7;
+    for (j = 0; j < GD; j++) fy[j] = 7;
     w = vpdsi_gap_max_above(d, lo, hi, faces, p, n, v < 0 ? 0 : v, fy);
     CHECK(w == -1 && fy[0] == 7 && fy[d - 1] == 7);
 }
@@ -56,7 +58,7 @@ static void check_floors(int d, const double *lo, const double *hi, unsigned fac
 /* One random configuration: a box and n points (some outside it), checked by probes. */
 static void check_gap_once(int d, int n, int probes)
 {
-    double lo[4], hi[4], p[VPDSI_GAP_MAX_POINTS * 4], y[4], v, top = 0;
+    double lo[GD], hi[GD], p[VPDSI_GAP_MAX_POINTS * GD], y[GD], v, top = 0;
     int i, k, inside = 1;
     for (k = 0; k < d; k++) {
         lo[k] = unit() * 2 - 1;
@@ -71,7 +73,7 @@ static void check_gap_once(int d, int n, int probes)
     CHECK_MSG(fabs(nearest2(d, p, n, y) - v) <= 1e-12 * v, "d %d n %d: gap at y %.17g, reported %.17g",
               d, n, nearest2(d, p, n, y), v);
     for (i = 0; i < probes; i++) {
-        double q[4], g;
+        double q[GD], g;
         for (k = 0; k < d; k++) {
             /* a third of the probes on faces, where the boundary maxima lie */
             double u = unit();
@@ -89,7 +91,7 @@ static void check_gap_once(int d, int n, int probes)
         unsigned b;
         double found = -1;
         for (b = 0; b < (1u << d); b++) {
-            double plo[4], phi[4], py[4], pv;
+            double plo[GD], phi[GD], py[GD], pv;
             unsigned faces = 0;
             int holds = 1;
             for (k = 0; k < d; k++) {
@@ -177,7 +179,7 @@ static void check_dominated(int d)
 {
     int trial;
     for (trial = 0; trial < 2000; trial++) {
-        double lo[4], hi[4], a[4], b[4];
+        double lo[GD], hi[GD], a[GD], b[GD];
         int k, i, dom;
         for (k = 0; k < d; k++) {
             lo[k] = unit();
@@ -187,7 +189,7 @@ static void check_dominated(int d)
         }
         dom = vpdsi_gap_dominated(d, lo, hi, a, b);
         for (i = 0; i < (dom ? 200 : 0); i++) {
-            double q[4];
+            double q[GD];
             for (k = 0; k < d; k++) q[k] = lo[k] + unit() * (hi[k] - lo[k]);
             CHECK(nearest2(d, a, 1, q) < nearest2(d, b, 1, q));
         }
@@ -196,7 +198,7 @@ static void check_dominated(int d)
             unsigned c;
             int found = 0;
             for (c = 0; c < (1u << d); c++) {
-                double q[4];
+                double q[GD];
                 for (k = 0; k < d; k++) q[k] = c >> k & 1u ? hi[k] : lo[k];
                 if (nearest2(d, a, 1, q) >= nearest2(d, b, 1, q) * (1 - 1e-12)) found = 1;
             }
@@ -279,7 +281,7 @@ static double brute_gap(int d, int periodic, const double *p, int n)
 static void check_search(void)
 {
     static int32_t scratch[VPDSI_GAP_SCRATCH(400)];
-    double p[400 * 4], y[4], best;
+    double p[400 * GD], y[GD], best;
     int trial, i, k;
     for (trial = 0; trial < (quick ? 40 : 300); trial++) {
         double lo[2] = {0, 0}, hi[2] = {1, 1};
@@ -300,7 +302,7 @@ static void check_search(void)
     }
     for (trial = 0; trial < (quick ? 6 : 60); trial++) {
         int d = 3 + trial % 2, n = 50 + trial * 5;
-        double lo[4], hi[4], top = 0;
+        double lo[GD], hi[GD], top = 0;
         for (k = 0; k < d; k++) {
             lo[k] = 0;
             hi[k] = 1;
@@ -309,7 +311,7 @@ static void check_search(void)
         CHECK(vpdsi_gap_search(d, lo, hi, p, n, scratch, &best, y));
         CHECK(fabs(nearest2(d, p, n, y) / best - 1) < 1e-10);
         for (i = 0; i < 4000; i++) {
-            double q[4], g;
+            double q[GD], g;
             for (k = 0; k < d; k++) q[k] = unit();
             if (i % 2) q[i % d] = (double)(i / 2 % 2);
             g = nearest2(d, p, n, q);
@@ -354,7 +356,7 @@ static void check_stream_exact(int d, const int *periodic, size_t n, int grid)
 {
     vpds_desc desc = vpds_default_desc();
     vpds_sampler *s = NULL;
-    double x[3], t, r = 0.05;
+    double x[GD], t, r = 0.05;
     size_t i, j;
     desc.dim = d;
     desc.radius = r;
@@ -380,7 +382,7 @@ static void check_stream_exact(int d, const int *periodic, size_t n, int grid)
             double worst = 0;
             for (k = 0; k < d; k++) cells *= grid + 1;
             for (c = 0; c < cells; c++) {
-                double q[3], e2 = INFINITY;
+                double q[GD], e2 = INFINITY;
                 long rest = c;
                 for (k = 0; k < d; k++) {
                     q[k] = (double)(rest % (grid + 1)) / grid;
@@ -408,7 +410,9 @@ int main(void)
     for (d = 1; d <= VPDSI_GAP_MAX_DIM; d++) {
         check_dominated(d);
         for (n = 1; n <= VPDSI_GAP_MAX_POINTS; n++)
-            for (rep = 0; rep < (quick ? 5 : d > 2 ? 40 : 100); rep++) check_gap_once(d, n, d > 2 ? 3000 : 2000);
+            /* 5D and 6D: few repetitions (up to 10 points with every face: 10^5 vertices) */
+            for (rep = 0; rep < (d > 4 ? (quick ? n % 3 == 0 : 3) : quick ? 5 : d > 2 ? 40 : 100); rep++)
+                check_gap_once(d, n, d > 2 ? 3000 : 2000);
     }
     for (n = 1; n <= VPDSI_SURFACE_GAP_MAX_POINTS; n++)
         for (rep = 0; rep < (quick ? 5 : 60); rep++) check_triangle_gap_once(n, quick ? 60 : 200);
@@ -420,5 +424,8 @@ int main(void)
     check_stream_exact(2, NULL, 300, 300);
     check_stream_exact(2, both, 300, 300);
     check_stream_exact(3, one3, 150, 40);
+    /* version 9: exact in 5D and 6D too */
+    check_stream_exact(5, NULL, quick ? 30 : 80, 6);
+    check_stream_exact(6, NULL, quick ? 20 : 50, 4);
     CHECK_DONE();
 }

@@ -182,8 +182,8 @@ def test_algorithm_version_pins_the_mesh_stream():
                                   vpds.sample_mesh(m, radius=0.2, rng=3).points)
     np.testing.assert_array_equal(vpds.sample_mesh(m, radius=0.2, n=80, rng=3, algorithm_version=8).points,
                                   current.points)
-    for bad in (2, 9, -1, 1.5, True):
-        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 3\.\.8"):
+    for bad in (2, 10, -1, 1.5, True):
+        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 3\.\.9"):
             vpds.sample_mesh(m, algorithm_version=bad)
 
 

@@ -222,9 +222,10 @@ def test_algorithm_version_pins_the_points():
     version 5 made the stream of one radius exact (its runs are version 4's); version 6 made the
     two-radii search skip the sub-boxes it showed covered (the points of 5 here); version 7
     changed only the stream on meshes (boxes give the points of 6); version 8 made the coverage
-    search test a splitting box's far corner (the points of 7); a version the library does not
-    have is refused."""
-    assert vpds.ALGORITHM_VERSION == 8
+    search test a splitting box's far corner (the points of 7); version 9 made the stream exact
+    in 5D and 6D (2D streams and every run keep the points of 8); a version the library does
+    not have is refused."""
+    assert vpds.ALGORITHM_VERSION == 9
 
     def fill(version, inhibition):
         engine = vpds.PoissonDisk(2, sizing=lambda x: 0.04 + 0.04 * x[:, 0], lipschitz=0.04,
@@ -238,6 +239,7 @@ def test_algorithm_version_pins_the_points():
     assert np.array_equal(current, fill(6, 0.6))
     assert np.array_equal(current, fill(7, 0.6))
     assert np.array_equal(current, fill(8, 0.6))
+    assert np.array_equal(current, fill(9, 0.6))
     assert np.array_equal(current, v3)
     assert np.array_equal(v2, v3)
     assert not np.array_equal(v1, v2)
@@ -252,7 +254,16 @@ def test_algorithm_version_pins_the_points():
     assert np.array_equal(stream(6), stream(5))
     assert np.array_equal(stream(7), stream(5))
     assert np.array_equal(stream(8), stream(5))
+    assert np.array_equal(stream(9), stream(5))
     assert not np.array_equal(stream(5), stream(4))
-    for bad in (9, -1, 1.5, True):
-        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.8"):
+
+    def stream5(version):
+        engine = vpds.PoissonDisk(5, sizing=0.3, seed=3, algorithm_version=version)
+        return np.array([x for x, _ in itertools.islice(engine.stream(), 30)])
+
+    # 5D: version 9's farthest points are exact, version 8's within the tolerance
+    assert np.array_equal(stream5(None), stream5(9))
+    assert not np.array_equal(stream5(9), stream5(8))
+    for bad in (10, -1, 1.5, True):
+        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.9"):
             vpds.PoissonDisk(2, algorithm_version=bad)
