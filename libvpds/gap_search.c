@@ -68,15 +68,33 @@ static int filter(const gap_box_search *q, const int32_t *in, int n_in, const do
     return n;
 }
 
+/* Child b of the box [lo, hi] (bit k of b: the upper half on axis k) into [clo, chi], and the
+ * outer faces it keeps: on each axis the one on its side (the low half the low one). Made
+ * again where needed rather than kept for all 2^d children: a frame stays small in 6D. */
+static unsigned child_box(int d, const double *lo, const double *hi, unsigned faces, unsigned b,
+                          double *clo, double *chi)
+{
+    unsigned kept = 0;
+    int k;
+    for (k = 0; k < d; k++) {
+        unsigned high = b >> k & 1u;
+        double mid = 0.5 * (lo[k] + hi[k]);
+        clo[k] = high ? mid : lo[k];
+        chi[k] = high ? hi[k] : mid;
+        kept |= faces & (1u << (2 * k + high));
+    }
+    return kept;
+}
+
 /* The largest squared gap over the box into q (its reach2 given); 0 when the depth runs out.
  * The children go in order of their reach, largest first, so that a good best comes early. */
 static int search_box(gap_box_search *q, const double *lo, const double *hi, unsigned faces,
                       double reach2, int depth, int n_in)
 {
-    int d = q->d, n, i, k, order[1 << D];
+    int d = q->d, n, i, order[1 << D];
     int32_t *in = q->lists + (size_t)depth * q->n, *out = in + q->n;
-    double pts[VPDSI_GAP_MAX_POINTS * D], y[D], clo[1 << D][D], chi[1 << D][D], key[1 << D];
-    unsigned b, nb = 1u << d, kid_faces[1 << D];
+    double pts[VPDSI_GAP_MAX_POINTS * D], y[D], clo[D], chi[D], key[1 << D];
+    unsigned b, nb = 1u << d;
     if (reach2 <= q->best) return 1; /* no point of the box beats the best */
     n = filter(q, in, n_in, lo, hi, reach2, out);
     /* the last depth takes as many points as one enumeration can */
@@ -92,24 +110,16 @@ static int search_box(gap_box_search *q, const double *lo, const double *hi, uns
     }
     if (depth + 1 == VPDSI_GAP_SEARCH_DEPTH) return 0;
     for (b = 0; b < nb; b++) {
-        kid_faces[b] = 0;
-        for (k = 0; k < d; k++) {
-            /* a child keeps the outer faces on its side of each axis: the low half the low one */
-            unsigned high = b >> k & 1u;
-            double mid = 0.5 * (lo[k] + hi[k]);
-            clo[b][k] = high ? mid : lo[k];
-            chi[b][k] = high ? hi[k] : mid;
-            kid_faces[b] |= faces & (1u << (2 * k + high));
-        }
-        key[b] = reach2_of(q, out, n, clo[b], chi[b]);
+        child_box(d, lo, hi, faces, b, clo, chi);
+        key[b] = reach2_of(q, out, n, clo, chi);
         /* insertion into order by key, largest first */
         for (i = (int)b; i > 0 && key[order[i - 1]] < key[b]; i--) order[i] = order[i - 1];
         order[i] = (int)b;
     }
-    for (b = 0; b < nb; b++)
-        if (!search_box(q, clo[order[b]], chi[order[b]], kid_faces[order[b]], key[order[b]], depth + 1,
-                        n))
-            return 0;
+    for (b = 0; b < nb; b++) {
+        unsigned kept = child_box(d, lo, hi, faces, (unsigned)order[b], clo, chi);
+        if (!search_box(q, clo, chi, kept, key[order[b]], depth + 1, n)) return 0;
+    }
     return 1;
 }
 
