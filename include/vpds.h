@@ -68,8 +68,8 @@ extern "C" {
  * stream's search to the tolerance (a variable radius, a domain) finds the nearest samples of a
  * split's children in a list its parent's split made, filtered, not in the kd-tree (the same
  * minimum; the first of equally near samples may differ: the points of version 7 on every
- * golden configuration). 9: the stream's exact farthest point (one radius, no domain) in 5D and
- * 6D too, where version 8 searched to the tolerance (other points for vpds_next in 5D and 6D;
+ * golden configuration). 9: the stream's exact farthest point (one radius, no domain) in 5D to
+ * 7D too, where version 8 searched to the tolerance (other points for vpds_next in 5D to 7D;
  * everything else gives the points of version 8). */
 #define VPDS_ALGORITHM_VERSION 9
 /* Largest supported dimension; a larger dim is refused by vpds_create. */

@@ -1,11 +1,11 @@
 /* The largest gap in a box among a few points: max over y in [lo, hi] of min_i |y - p_i|, found
- * exactly up to round-off (the stream's exact local search, algorithm version 5; in 5D and 6D
+ * exactly up to round-off (the stream's exact local search, algorithm version 5; in 5D to 7D
  * from version 9). */
 #ifndef VPDS_GAP_H
 #define VPDS_GAP_H
 
-#define VPDSI_GAP_MAX_DIM 6    /* the vertex enumeration grows as C(n, d + 1) 2^d: small d only */
-/* Versions 5-8 searched exactly up to 4D (5D and 6D to the tolerance); 9 up to 6D */
+#define VPDSI_GAP_MAX_DIM 7    /* the vertex enumeration grows as C(n, d + 1) 2^d: small d only */
+/* Versions 5-8 searched exactly up to 4D (5D and up to the tolerance); 9 up to 7D */
 #define VPDSI_GAP_V5_MAX_DIM 4
 #define VPDSI_GAP_MAX_POINTS 10 /* points one enumeration takes */
 

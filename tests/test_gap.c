@@ -410,8 +410,8 @@ int main(void)
     for (d = 1; d <= VPDSI_GAP_MAX_DIM; d++) {
         check_dominated(d);
         for (n = 1; n <= VPDSI_GAP_MAX_POINTS; n++)
-            /* 5D and 6D: few repetitions (up to 10 points with every face: 10^5 vertices) */
-            for (rep = 0; rep < (d > 4 ? (quick ? n % 3 == 0 : 3) : quick ? 5 : d > 2 ? 40 : 100); rep++)
+            /* 5D to 7D: few repetitions (up to 10 points with every face: 10^5 vertices) */
+            for (rep = 0; rep < (d > 6 ? n == 8 : d > 4 ? (quick ? n % 3 == 0 : 3) : quick ? 5 : d > 2 ? 40 : 100); rep++)
                 check_gap_once(d, n, d > 2 ? 3000 : 2000);
     }
     for (n = 1; n <= VPDSI_SURFACE_GAP_MAX_POINTS; n++)
@@ -424,8 +424,9 @@ int main(void)
     check_stream_exact(2, NULL, 300, 300);
     check_stream_exact(2, both, 300, 300);
     check_stream_exact(3, one3, 150, 40);
-    /* version 9: exact in 5D and 6D too */
+    /* version 9: exact in 5D to 7D too */
     check_stream_exact(5, NULL, quick ? 30 : 80, 6);
     check_stream_exact(6, NULL, quick ? 20 : 50, 4);
+    check_stream_exact(7, NULL, quick ? 8 : 15, 3);
     CHECK_DONE();
 }
