@@ -139,11 +139,24 @@ static int popcount(unsigned v)
     return c;
 }
 
+/* The squared distance from point i (q: centred coordinates) to the farthest corner of the
+ * box's face on axis k, side `side`, summed term by term (a difference from the whole box's
+ * farthest corner would cancel). */
+static double face_far2(int d, const double *h, const double *qi, int k, int side)
+{
+    double s = 0;
+    int j;
+    for (j = 0; j < d; j++) {
+        double e = j != k ? fabs(qi[j]) + h[j] : side ? h[j] - qi[j] : -h[j] - qi[j];
+        s += e * e;
+    }
+    return s;
+}
+
 /* The faces (of those in `faces`) no single point holds within floor: on a face whose every
  * corner lies within floor of one point, the ball being convex, no vertex can exceed floor (the
- * margin covers round-off). far2[i]: point i's farthest corner of the box. */
-static unsigned uncovered_faces(int d, const double *h, const double *q, const double *far2, int n,
-                                double floor)
+ * margin covers round-off). */
+static unsigned uncovered_faces(int d, const double *h, const double *q, int n, double floor)
 {
     unsigned open = 0;
     int k, side, i;
@@ -151,10 +164,7 @@ static unsigned uncovered_faces(int d, const double *h, const double *q, const d
     for (k = 0; k < d; k++)
         for (side = 0; side < 2; side++) {
             int held = 0;
-            for (i = 0; i < n && !held; i++) {
-                double qk = q[i * D + k], across = fabs(qk) + h[k], to = side ? h[k] - qk : -h[k] - qk;
-                held = (far2[i] - across * across + to * to) * (1 + 1e-9) <= floor;
-            }
+            for (i = 0; i < n && !held; i++) held = face_far2(d, h, q + i * D, k, side) * (1 + 1e-9) <= floor;
             if (!held) open |= 1u << (2 * k + side);
         }
     return open;
@@ -163,8 +173,7 @@ static unsigned uncovered_faces(int d, const double *h, const double *q, const d
 double vpdsi_gap_max_above(int d, const double *lo, const double *hi, unsigned faces,
                            const double *p, int n, double floor, double *y)
 {
-    double c[D], h[D], q[VPDSI_GAP_MAX_POINTS * D], far2[VPDSI_GAP_MAX_POINTS], A[D][D] = {{0}};
-    double b[D] = {0};
+    double c[D], h[D], q[VPDSI_GAP_MAX_POINTS * D], A[D][D] = {{0}}, b[D] = {0};
     gap_search g;
     unsigned mask, axes;
     int i, k, usable[1 << D], any[D + 2] = {0};
@@ -172,14 +181,9 @@ double vpdsi_gap_max_above(int d, const double *lo, const double *hi, unsigned f
         c[k] = 0.5 * (lo[k] + hi[k]);
         h[k] = 0.5 * (hi[k] - lo[k]);
     }
-    for (i = 0; i < n; i++) {
-        far2[i] = 0;
-        for (k = 0; k < d; k++) {
-            q[i * D + k] = p[i * d + k] - c[k];
-            far2[i] += (fabs(q[i * D + k]) + h[k]) * (fabs(q[i * D + k]) + h[k]);
-        }
-    }
-    faces &= uncovered_faces(d, h, q, far2, n, floor);
+    for (i = 0; i < n; i++)
+        for (k = 0; k < d; k++) q[i * D + k] = p[i * d + k] - c[k];
+    faces &= uncovered_faces(d, h, q, n, floor);
     g.d = d;
     g.n = n;
     g.faces = faces;
