@@ -30,7 +30,7 @@ SAN_FLAGS := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-
 # Fuzzing: the harnesses FUZZERS, from FUZZ_DIR/fuzz_<name>.c with seeds in FUZZ_DIR/corpus/<name>,
 # built and run in FUZZ_OUT (logs, grown corpora, and libFuzzer's crash-, leak-, timeout- and oom-
 # inputs in FUZZ_OUT/artifacts). tests/fuzz_fails.sh points these at harnesses that must fail.
-FUZZERS ?= run grid sequence sizing domain tiles mesh
+FUZZERS ?= run grid sequence sizing domain tiles mesh voids
 FUZZ_DIR ?= fuzz
 FUZZ_OUT ?= $(BUILD)/fuzz
 FUZZ_SECONDS ?= 120

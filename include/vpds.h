@@ -70,8 +70,13 @@ extern "C" {
  * minimum; the first of equally near samples may differ: the points of version 7 on every
  * golden configuration). 9: the stream's exact farthest point (one radius, no domain) in 5D to
  * 7D too, where version 8 searched to the tolerance (other points for vpds_next in 5D to 7D;
- * everything else gives the points of version 8). */
-#define VPDS_ALGORITHM_VERSION 9
+ * everything else gives the points of version 8). 10: the stream's farthest point in 2D (one
+ * radius, no domain, open axes) is read from the Voronoi diagram of the samples, kept as a
+ * Delaunay triangulation that each sample changes only around itself, where version 9
+ * searched regions of the box: the same largest gaps to round-off, other bits, and where two
+ * points are equally far another may come first (other points for vpds_next in 2D; everything
+ * else gives the points of version 9). */
+#define VPDS_ALGORITHM_VERSION 10
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 16
 /* Relative tolerance eps of the continuous stream (vpds_next): each t it reports is an upper

@@ -26,6 +26,7 @@ void vpdsi_stream_init(vpdsi_stream *sm)
 {
     memset(sm, 0, sizeof *sm);
     vpdsi_region_heap_init(&sm->regions, 0);
+    vpdsi_voids_init(&sm->voids);
 }
 
 void vpdsi_stream_release(vpdsi_stream *sm, vpdsi_mem *m)
@@ -39,6 +40,7 @@ void vpdsi_stream_release(vpdsi_stream *sm, vpdsi_mem *m)
     vpdsi_mem_free(m, sm->cand_x, sm->cap_cand_x * sizeof(double));
     vpdsi_mem_free(m, sm->lists, sm->cap_lists * sizeof(int32_t));
     vpdsi_mem_free(m, sm->near, sm->cap_near * sizeof(int32_t));
+    vpdsi_voids_release(&sm->voids, m);
     vpdsi_stream_init(sm);
 }
 
@@ -885,6 +887,57 @@ static vpds_status event_sample(const vpdsi_ctx *ctx, double t, const double *y,
     return ctx->pb->two_radii ? draw_near(ctx, t, y, ry, x, rx) : VPDS_OK;
 }
 
+/* Version 10 finds the farthest point from the Voronoi diagram of the samples (voids.c) with
+ * one radius in an open 2D box: exact, and changed only around each new sample. */
+static int voids_apply(const vpdsi_ctx *ctx)
+{
+    return ctx->pb->algorithm >= 10 && ctx->pb->dim == 2 && !ctx->pb->any_periodic &&
+           ctx->st->sizing.kind == VPDSI_SIZING_CONSTANT && !ctx->dom->fn;
+}
+
+/* One event from the Voronoi diagram (after a store reserve, with a sample in the store).
+ * *served = 0 when the triangulation gave way (a sample outside the box or of another radius,
+ * or round-off broke a cavity): the regions then take over, from the same samples. */
+static vpds_status voids_event(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_min, double t_cap,
+                               double *x_out, double *t_out, int *served)
+{
+    vpdsi_store *st = ctx->st;
+    vpdsi_rng start = *ctx->rng;
+    double y[2], x[2], g2, ry, rx, t;
+    vpds_status e;
+    size_t i;
+    int sync = 0;
+    /* a fixed point of another radius makes g a weighted distance: the regions' search */
+    for (i = sm->voids.n; i < st->n && !sync; i++)
+        if (st->r[i] != st->sizing.radius) sync = -2;
+    if (!sync) sync = vpdsi_voids_sync(&sm->voids, ctx->mem, ctx->pb->lo, ctx->pb->hi, st->x, st->n);
+    *served = sync != -2;
+    if (sync == -2) {
+        vpdsi_voids_release(&sm->voids, ctx->mem);
+        sm->voids_off = 1;
+        return VPDS_OK;
+    }
+    if (sync == -1) {
+        vpdsi_store_error(st, "out of memory for the stream's triangulation");
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    g2 = vpdsi_voids_farthest(&sm->voids, st->x, y);
+    if ((e = vpdsi_store_radius_at(st, y, &ry)) != VPDS_OK) return e;
+    t = sqrt(g2) / (ctx->pb->coverage * ry);
+    if (t > t_cap) t = t_cap;
+    if (t <= t_min) return VPDS_STREAM_END;
+    if (ctx->pb->two_radii && (e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
+    if ((e = event_sample(ctx, t, y, x, &rx)) != VPDS_OK) {
+        *ctx->rng = start;
+        return e;
+    }
+    vpdsi_store_append(st, x, rx, t, 0);
+    ctx->stats->accepted++;
+    memcpy(x_out, x, sizeof x);
+    *t_out = t;
+    return VPDS_OK;
+}
+
 vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_min, double t_cap,
                               double *x_out, double *t_out)
 {
@@ -893,6 +946,12 @@ vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_m
     uint64_t rec[3 + 2 * VPDS_MAX_DIM];
     vpdsi_rng start = *ctx->rng;
     vpds_status e;
+    if (st->n > 0 && !sm->voids_off && voids_apply(ctx)) {
+        int served;
+        if ((e = vpdsi_store_reserve(st, 1)) != VPDS_OK) return e;
+        e = voids_event(sm, ctx, t_min, t_cap, x_out, t_out, &served);
+        if (served) return e;
+    }
     if ((e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
     if ((e = vpdsi_store_reserve(st, 1)) != VPDS_OK) return e;
     /* version 3: sm->lb, the largest g seen since the last sample, is a lower bound of max g;

@@ -4,6 +4,7 @@
 #include "cells.h"
 #include "context.h"
 #include "region_heap.h"
+#include "voids.h"
 
 /* The box is cut into regions (cells of a lazily refined grid) in a max-heap keyed by an upper
  * bound of g = distance to the samples over coverage * f, the scale at which a point becomes
@@ -29,6 +30,10 @@ typedef struct vpdsi_stream {
     /* version 8: the samples that may be nearest in an open box of the search, one list per
      * split shared by its children, which filter it for theirs */
     int32_t *near; size_t n_near, cap_near;
+    /* version 10, one radius in 2D: the Voronoi diagram's candidates (voids.h), until a sample
+     * outside the box or round-off makes it give way to the regions (voids_off) */
+    vpdsi_voids voids;
+    int voids_off;
 } vpdsi_stream;
 
 void vpdsi_stream_init(vpdsi_stream *sm);

@@ -1,0 +1,250 @@
+/* The stream's farthest point in 2D from the Voronoi diagram (voids.h): one candidate per
+ * Delaunay triangle, the triangles in an indexed max-heap (ties to the lower triangle index,
+ * so that the order is a function of the triangulation alone). */
+#include "voids.h"
+#include <math.h>
+#include <string.h>
+
+void vpdsi_voids_init(vpdsi_voids *vd)
+{
+    memset(vd, 0, sizeof *vd);
+}
+
+void vpdsi_voids_release(vpdsi_voids *vd, vpdsi_mem *m)
+{
+    vpdsi_dt_release(&vd->dt, m);
+    vpdsi_mem_free(m, vd->key, vd->cap_key * sizeof(double));
+    vpdsi_mem_free(m, vd->tri, vd->cap_tri * sizeof(uint32_t));
+    vpdsi_mem_free(m, vd->pos, vd->cap_pos * sizeof(uint32_t));
+    vpdsi_voids_init(vd);
+}
+
+static double vd_dist2(const double *a, const double *b)
+{
+    return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]);
+}
+
+static int vd_in_box(const vpdsi_dt *dt, const double *y)
+{
+    return y[0] >= dt->lo[0] && y[0] <= dt->hi[0] && y[1] >= dt->lo[1] && y[1] <= dt->hi[1];
+}
+
+/* The centre of the circle through a, b, c (counter-clockwise); -1 when they are collinear. */
+static int vd_circumcentre(const double *a, const double *b, const double *c, double *y)
+{
+    double bx = b[0] - a[0], by = b[1] - a[1], cx = c[0] - a[0], cy = c[1] - a[1];
+    double den = 2 * (bx * cy - by * cx), b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
+    if (!(den > 0)) return -1;
+    y[0] = a[0] + (cy * b2 - by * c2) / den;
+    y[1] = a[1] + (bx * c2 - cx * b2) / den;
+    return 0;
+}
+
+/* The farthest point where the bisector of samples p, q meets the box's boundary within
+ * their Voronoi edge: no nearer to o1 (opposite in this triangle) or o2 (across the edge)
+ * than to them, which on the bisector is exactly the segment between the two circumcentres.
+ * Its squared gap, or -1. */
+static double vd_edge_crossing(const vpdsi_dt *dt, const double *pts, uint32_t p, uint32_t q,
+                               uint32_t o1, uint32_t o2, double *y)
+{
+    const double *a = vpdsi_dt_point(dt, pts, p), *b = vpdsi_dt_point(dt, pts, q);
+    double best = -1;
+    int k, side;
+    for (k = 0; k < 2; k++) {
+        int j = 1 - k;
+        double dk = b[k] - a[k], dj = b[j] - a[j];
+        if (dj == 0) continue; /* the bisector is parallel to the sides across axis k */
+        for (side = 0; side < 2; side++) {
+            double x[2], g2, s = side ? dt->hi[k] : dt->lo[k];
+            x[k] = s;
+            x[j] = 0.5 * (a[j] + b[j]) - (s - 0.5 * (a[k] + b[k])) * dk / dj;
+            if (!(x[j] >= dt->lo[j] && x[j] <= dt->hi[j])) continue;
+            g2 = vd_dist2(x, a);
+            if (vd_dist2(x, b) < g2) g2 = vd_dist2(x, b);
+            if (g2 <= best) continue;
+            if (o1 >= VPDSI_DT_FAR && vd_dist2(x, vpdsi_dt_point(dt, pts, o1)) < g2) continue;
+            if (o2 != VPDSI_DT_NONE && o2 >= VPDSI_DT_FAR && vd_dist2(x, vpdsi_dt_point(dt, pts, o2)) < g2)
+                continue;
+            best = g2;
+            y[0] = x[0];
+            y[1] = x[1];
+        }
+    }
+    return best;
+}
+
+/* Triangle t's candidate: its circumcentre when inside the box (a Voronoi vertex), and the
+ * boundary crossings of the edges it owns (an edge (p, q) belongs to the triangle that sees
+ * p < q, so each edge is computed once). Its squared gap (-1: none) and its point y. */
+static double vd_candidate(const vpdsi_voids *vd, const double *pts, uint32_t t, double *y)
+{
+    const vpdsi_dt *dt = &vd->dt;
+    const uint32_t *v = dt->tv + 3 * (size_t)t;
+    double best = -1, z[2] = {0, 0};
+    int i;
+    if (v[0] >= VPDSI_DT_FAR && v[1] >= VPDSI_DT_FAR && v[2] >= VPDSI_DT_FAR) {
+        const double *a = vpdsi_dt_point(dt, pts, v[0]), *b = vpdsi_dt_point(dt, pts, v[1]);
+        const double *c = vpdsi_dt_point(dt, pts, v[2]);
+        if (vd_circumcentre(a, b, c, z) == 0 && vd_in_box(dt, z)) {
+            best = vd_dist2(z, a);
+            if (vd_dist2(z, b) < best) best = vd_dist2(z, b);
+            if (vd_dist2(z, c) < best) best = vd_dist2(z, c);
+            y[0] = z[0];
+            y[1] = z[1];
+        }
+    }
+    for (i = 0; i < 3; i++) {
+        uint32_t p = v[(i + 1) % 3], q = v[(i + 2) % 3], u = dt->tn[3 * (size_t)t + (size_t)i];
+        uint32_t o2 = VPDSI_DT_NONE;
+        double g2;
+        int w;
+        if (p >= q || p < VPDSI_DT_FAR) continue;
+        if (u != VPDSI_DT_NONE)
+            for (w = 0; w < 3; w++) {
+                uint32_t c = dt->tv[3 * (size_t)u + (size_t)w];
+                if (c != p && c != q) o2 = c;
+            }
+        g2 = vd_edge_crossing(dt, pts, p, q, v[i], o2, z);
+        if (g2 > best) {
+            best = g2;
+            y[0] = z[0];
+            y[1] = z[1];
+        }
+    }
+    return best;
+}
+
+/* ---- the indexed heap ---- */
+
+static int vd_above(const vpdsi_voids *vd, size_t i, size_t j)
+{
+    return vd->key[i] > vd->key[j] || (vd->key[i] == vd->key[j] && vd->tri[i] < vd->tri[j]);
+}
+
+static void vd_swap(vpdsi_voids *vd, size_t i, size_t j)
+{
+    double k = vd->key[i];
+    uint32_t t = vd->tri[i];
+    vd->key[i] = vd->key[j];
+    vd->tri[i] = vd->tri[j];
+    vd->key[j] = k;
+    vd->tri[j] = t;
+    vd->pos[vd->tri[i]] = (uint32_t)i;
+    vd->pos[vd->tri[j]] = (uint32_t)j;
+}
+
+static void vd_sift(vpdsi_voids *vd, size_t i)
+{
+    while (i > 0 && vd_above(vd, i, (i - 1) / 2)) {
+        vd_swap(vd, i, (i - 1) / 2);
+        i = (i - 1) / 2;
+    }
+    for (;;) {
+        size_t c = 2 * i + 1, best = i;
+        if (c < vd->count && vd_above(vd, c, best)) best = c;
+        if (c + 1 < vd->count && vd_above(vd, c + 1, best)) best = c + 1;
+        if (best == i) return;
+        vd_swap(vd, i, best);
+        i = best;
+    }
+}
+
+/* Triangle t's entry made to hold its candidate's key (key < 0: none), after a reserve. */
+static void vd_set(vpdsi_voids *vd, uint32_t t, double key)
+{
+    size_t i = vd->pos[t];
+    if (key < 0) {
+        if (vd->pos[t] == VPDSI_DT_NONE) return;
+        vd->pos[t] = VPDSI_DT_NONE;
+        if (i == --vd->count) return;
+        vd->key[i] = vd->key[vd->count];
+        vd->tri[i] = vd->tri[vd->count];
+        vd->pos[vd->tri[i]] = (uint32_t)i;
+    } else {
+        if (vd->pos[t] == VPDSI_DT_NONE) i = vd->count++;
+        vd->key[i] = key;
+        vd->tri[i] = t;
+        vd->pos[t] = (uint32_t)i;
+    }
+    vd_sift(vd, i);
+}
+
+static void vd_update(vpdsi_voids *vd, const double *pts, uint32_t t)
+{
+    double y[2];
+    vd_set(vd, t, vd_candidate(vd, pts, t, y));
+}
+
+/* Room for the entries of two more triangles. */
+static int vd_reserve(vpdsi_voids *vd, vpdsi_mem *m)
+{
+    size_t need = vd->dt.n_tri + 2;
+    return vpdsi_mem_reserve(m, (void **)&vd->key, &vd->cap_key, need, sizeof(double)) ||
+           vpdsi_mem_reserve(m, (void **)&vd->tri, &vd->cap_tri, need, sizeof(uint32_t)) ||
+           vpdsi_mem_reserve(m, (void **)&vd->pos, &vd->cap_pos, need, sizeof(uint32_t));
+}
+
+static int vd_start(vpdsi_voids *vd, vpdsi_mem *m, const double *lo, const double *hi)
+{
+    int k;
+    if (vpdsi_dt_init(&vd->dt, m, lo, hi)) return -1;
+    if (vd_reserve(vd, m)) {
+        vpdsi_voids_release(vd, m);
+        return -1;
+    }
+    vd->pos[0] = VPDSI_DT_NONE;
+    for (k = 0; k < 4; k++) vd->corner_d2[k] = INFINITY;
+    vd->hint = VPDSI_DT_NONE;
+    vd->ready = 1;
+    return 0;
+}
+
+int vpdsi_voids_sync(vpdsi_voids *vd, vpdsi_mem *m, const double *lo, const double *hi,
+                     const double *pts, size_t n)
+{
+    if (!vd->ready && vd_start(vd, m, lo, hi)) return -1;
+    while (vd->n < n) {
+        const double *p = pts + 2 * vd->n;
+        size_t before = vd->dt.n_tri, j;
+        int e, k;
+        if (!vd_in_box(&vd->dt, p)) return -2;
+        if (vd_reserve(vd, m)) return -1;
+        e = vpdsi_dt_insert(&vd->dt, m, pts, vd->n, vd->hint);
+        if (e < 0) return e;
+        if (e == 0) {
+            for (j = before; j < vd->dt.n_tri; j++) vd->pos[j] = VPDSI_DT_NONE;
+            for (j = 0; j < vd->dt.n_rim; j++) {
+                uint32_t u = vd->dt.rim[3 * j + 2];
+                vd_update(vd, pts, vd->dt.fresh[j]);
+                if (u != VPDSI_DT_NONE) vd_update(vd, pts, u);
+            }
+        }
+        for (k = 0; k < 4; k++) {
+            double c[2], d2;
+            c[0] = k & 1 ? hi[0] : lo[0];
+            c[1] = k & 2 ? hi[1] : lo[1];
+            d2 = vd_dist2(c, p);
+            if (d2 < vd->corner_d2[k]) vd->corner_d2[k] = d2;
+        }
+        vd->hint = VPDSI_DT_NONE;
+        vd->n++;
+    }
+    return 0;
+}
+
+double vpdsi_voids_farthest(vpdsi_voids *vd, const double *pts, double *y)
+{
+    double best = -1;
+    int k;
+    if (vd->count) {
+        vd->hint = vd->tri[0];
+        best = vd_candidate(vd, pts, vd->tri[0], y);
+    }
+    for (k = 0; k < 4; k++)
+        if (vd->corner_d2[k] > best) {
+            best = vd->corner_d2[k];
+            y[0] = k & 1 ? vd->dt.hi[0] : vd->dt.lo[0];
+            y[1] = k & 2 ? vd->dt.hi[1] : vd->dt.lo[1];
+        }
+    return best;
+}

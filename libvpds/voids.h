@@ -1,0 +1,33 @@
+/* The farthest point of a 2D box from the samples (algorithm version 10's stream with one
+ * radius): the distance to the nearest sample, convex inside each Voronoi cell and along each
+ * Voronoi edge, is largest at a Voronoi vertex inside the box, where a Voronoi edge crosses
+ * the box's boundary, or at a corner. Each triangle of the Delaunay triangulation (delaunay.h)
+ * holds the best of its circumcentre and the crossings of its edges' bisectors; the triangles
+ * sit in a max-heap that an insertion changes only around the new sample. */
+#ifndef VPDS_VOIDS_H
+#define VPDS_VOIDS_H
+#include "delaunay.h"
+
+typedef struct vpdsi_voids {
+    int ready;                /* the triangulation is made */
+    vpdsi_dt dt;
+    size_t n;                 /* samples in it: the store's [0, n) */
+    double corner_d2[4];      /* each corner's squared distance to its nearest sample */
+    double *key; size_t cap_key;   /* the heap: squared gap of triangle tri[i]'s candidate */
+    uint32_t *tri; size_t cap_tri;
+    size_t count;
+    uint32_t *pos; size_t cap_pos; /* each triangle's place in the heap, or VPDSI_DT_NONE */
+    uint32_t hint;            /* the triangle of the last farthest point: the next walk's start */
+} vpdsi_voids;
+
+void vpdsi_voids_init(vpdsi_voids *vd);
+void vpdsi_voids_release(vpdsi_voids *vd, vpdsi_mem *m);
+/* Insert the samples [vd->n, n) of the box [lo, hi] (points pts, 2 per sample). Returns 0,
+ * -1 on OOM (the samples before the failing one are in), or -2 when a sample lies outside
+ * the box or round-off broke a cavity: the triangulation then no longer serves. */
+int vpdsi_voids_sync(vpdsi_voids *vd, vpdsi_mem *m, const double *lo, const double *hi,
+                     const double *pts, size_t n);
+/* The farthest point y of the box from the samples (after a sync with at least one sample)
+ * and its squared distance to the nearest one. */
+double vpdsi_voids_farthest(vpdsi_voids *vd, const double *pts, double *y);
+#endif

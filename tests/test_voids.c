@@ -1,0 +1,261 @@
+/* Version 10's farthest point in 2D (delaunay.c, voids.c), against brute force and against
+ * the exact search of version 9 (gap.c, a different algorithm):
+ * - the triangulation: counter-clockwise triangles whose neighbours point back, 2n + 1 of them,
+ *   and no point inside a circumcircle (brute force) on random points, a lattice full of
+ *   cocircular ties, points on the box's sides, duplicates;
+ * - the farthest point: its gap is its distance to the nearest point, and version 9's stream
+ *   given the same points (as fixed points) finds the same largest gap;
+ * - the stream: at checkpoints along 3,000 events, in a long box, after a run, with two radii,
+ *   and after a fixed point outside the box (where the regions take over), each event's t is
+ *   the largest gap version 9 finds for the points before it. */
+#include "check.h"
+#include "vpds.h"
+#include "voids.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int quick;
+static unsigned long long rng_state = 2024;
+static double unit(void)
+{
+    rng_state = rng_state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(rng_state >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static const double *pt(const vpdsi_dt *dt, const double *pts, uint32_t v)
+{
+    return vpdsi_dt_point(dt, pts, v);
+}
+
+static double orient(const double *a, const double *b, const double *c)
+{
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+/* The triangulation of pts[0, n) (inserted in order) is a valid Delaunay triangulation. */
+static void check_triangulation(const double *pts, size_t n, const double *lo, const double *hi,
+                                const char *what)
+{
+    vpdsi_mem m;
+    vpdsi_dt dt;
+    size_t i, t, dups = 0, bad_orient = 0, bad_link = 0, inside = 0;
+    vpdsi_mem_init(&m, NULL);
+    CHECK(vpdsi_dt_init(&dt, &m, lo, hi) == 0);
+    for (i = 0; i < n; i++) {
+        int e = vpdsi_dt_insert(&dt, &m, pts, i, VPDSI_DT_NONE);
+        CHECK_MSG(e == 0 || e == 1, "%s: insert %zu gave %d", what, i, e);
+        dups += e == 1;
+    }
+    CHECK_MSG(dt.n_tri == 2 * (n - dups) + 1, "%s: %zu triangles for %zu points", what, dt.n_tri, n - dups);
+    for (t = 0; t < dt.n_tri; t++) {
+        const uint32_t *v = dt.tv + 3 * t;
+        double cx, cy, r2;
+        int k;
+        bad_orient += !(orient(pt(&dt, pts, v[0]), pt(&dt, pts, v[1]), pt(&dt, pts, v[2])) > 0);
+        for (k = 0; k < 3; k++) {
+            uint32_t u = dt.tn[3 * t + (size_t)k], a = v[(k + 1) % 3], b = v[(k + 2) % 3];
+            int back = 0, w;
+            if (u == VPDSI_DT_NONE) {
+                bad_link += a >= VPDSI_DT_FAR || b >= VPDSI_DT_FAR; /* only the far edges are open */
+                continue;
+            }
+            for (w = 0; w < 3; w++)
+                back += dt.tn[3 * (size_t)u + (size_t)w] == t && dt.tv[3 * (size_t)u + (size_t)w] != a &&
+                        dt.tv[3 * (size_t)u + (size_t)w] != b;
+            bad_link += back != 1;
+        }
+        if (v[0] < VPDSI_DT_FAR || v[1] < VPDSI_DT_FAR || v[2] < VPDSI_DT_FAR) continue;
+        { /* the empty circle, with a margin for the round-off of the centre */
+            const double *a = pt(&dt, pts, v[0]), *b = pt(&dt, pts, v[1]), *c = pt(&dt, pts, v[2]);
+            double bx = b[0] - a[0], by = b[1] - a[1], qx = c[0] - a[0], qy = c[1] - a[1];
+            double den = 2 * (bx * qy - by * qx);
+            cx = a[0] + (qy * (bx * bx + by * by) - by * (qx * qx + qy * qy)) / den;
+            cy = a[1] + (bx * (qx * qx + qy * qy) - qx * (bx * bx + by * by)) / den;
+            r2 = (a[0] - cx) * (a[0] - cx) + (a[1] - cy) * (a[1] - cy);
+            for (i = 0; i < n; i++) {
+                double d2 = (pts[2 * i] - cx) * (pts[2 * i] - cx) + (pts[2 * i + 1] - cy) * (pts[2 * i + 1] - cy);
+                inside += d2 < r2 * (1 - 1e-9);
+            }
+        }
+    }
+    CHECK_MSG(bad_orient == 0 && bad_link == 0 && inside == 0,
+              "%s: %zu triangles not counter-clockwise, %zu bad links, %zu points inside a circumcircle",
+              what, bad_orient, bad_link, inside);
+    vpdsi_dt_release(&dt, &m);
+    CHECK(m.held == 0);
+}
+
+static void shuffle(double *p, size_t n)
+{
+    size_t i;
+    for (i = n; i > 1; i--) {
+        size_t j = (size_t)(unit() * (double)i);
+        double x = p[2 * (i - 1)], y = p[2 * (i - 1) + 1];
+        p[2 * (i - 1)] = p[2 * j];
+        p[2 * (i - 1) + 1] = p[2 * j + 1];
+        p[2 * j] = x;
+        p[2 * j + 1] = y;
+    }
+}
+
+static void check_triangulations(void)
+{
+    static const double lo[2] = {0, 0}, hi[2] = {1, 1};
+    size_t n = quick ? 300 : 2000, i, j, g = 21;
+    double *p = (double *)malloc(2 * n * sizeof(double)), *q = (double *)malloc(2 * g * g * sizeof(double));
+    for (i = 0; i < 2 * n; i++) p[i] = unit();
+    check_triangulation(p, n, lo, hi, "uniform points");
+    for (i = 0; i < g; i++)
+        for (j = 0; j < g; j++) {
+            q[2 * (i * g + j)] = (double)i / (double)(g - 1);
+            q[2 * (i * g + j) + 1] = (double)j / (double)(g - 1);
+        }
+    check_triangulation(q, g * g, lo, hi, "a lattice in row order");
+    shuffle(q, g * g);
+    check_triangulation(q, g * g, lo, hi, "a lattice shuffled");
+    for (i = 0; i < n; i++) { /* on the sides, the corners among them, some twice */
+        int side = (int)(unit() * 4);
+        double s = i % 7 == 0 ? 0.0 : i % 11 == 0 ? 1.0 : unit();
+        p[2 * i + (side & 1)] = side & 2 ? 1.0 : 0.0;
+        p[2 * i + 1 - (side & 1)] = s;
+    }
+    check_triangulation(p, n, lo, hi, "points on the sides");
+    free(p);
+    free(q);
+}
+
+/* Version 9's largest gap of points p[0, n) (fixed points of radius r) in the box: its first
+ * event's t times r. */
+static double gap_v9(const double *p, size_t n, const double *lo, const double *hi, double r)
+{
+    vpds_desc desc = vpds_default_desc();
+    vpds_sampler *s = NULL;
+    double x[2], t = -1;
+    desc.lo = lo;
+    desc.hi = hi;
+    desc.radius = r;
+    desc.algorithm_version = 9;
+    CHECK(vpds_create(&desc, &s) == VPDS_OK);
+    if (!s) return -1;
+    CHECK(vpds_add_points(s, p, NULL, n) == VPDS_OK);
+    CHECK(vpds_next(s, 0, x, &t) == VPDS_OK);
+    vpds_destroy(s);
+    return t * r;
+}
+
+static double nearest(const double *p, size_t n, const double *y)
+{
+    double best = INFINITY;
+    size_t i;
+    for (i = 0; i < n; i++) {
+        double d2 = (p[2 * i] - y[0]) * (p[2 * i] - y[0]) + (p[2 * i + 1] - y[1]) * (p[2 * i + 1] - y[1]);
+        if (d2 < best) best = d2;
+    }
+    return sqrt(best);
+}
+
+static void check_farthest(size_t n, const double *lo, const double *hi, int reps)
+{
+    double *p = (double *)malloc(2 * n * sizeof(double));
+    int rep;
+    for (rep = 0; rep < reps; rep++) {
+        vpdsi_mem m;
+        vpdsi_voids vd;
+        double y[2], g, oracle;
+        size_t i;
+        vpdsi_mem_init(&m, NULL);
+        vpdsi_voids_init(&vd);
+        for (i = 0; i < n; i++) {
+            p[2 * i] = lo[0] + unit() * (hi[0] - lo[0]);
+            p[2 * i + 1] = lo[1] + unit() * (hi[1] - lo[1]);
+        }
+        CHECK(vpdsi_voids_sync(&vd, &m, lo, hi, p, n) == 0);
+        g = sqrt(vpdsi_voids_farthest(&vd, p, y));
+        CHECK(y[0] >= lo[0] && y[0] <= hi[0] && y[1] >= lo[1] && y[1] <= hi[1]);
+        CHECK_MSG(fabs(nearest(p, n, y) / g - 1) < 1e-12, "%zu points: gap %.17g at its point, %.17g said",
+                  n, nearest(p, n, y), g);
+        oracle = gap_v9(p, n, lo, hi, 0.1);
+        CHECK_MSG(fabs(oracle / g - 1) < 1e-9, "%zu points: largest gap %.17g, version 9 %.17g", n, g, oracle);
+        vpdsi_voids_release(&vd, &m);
+        CHECK(m.held == 0);
+    }
+    free(p);
+}
+
+/* A version-10 stream of n events (one_radius: R_f = R_c, so each sample is the farthest point) from the sampler s; at each checkpoint k, event k's t * r
+ * equals version 9's largest gap of the points before it. */
+static void check_stream_oracle(vpds_sampler *s, size_t n, const double *lo, const double *hi, double r,
+                                int one_radius, const char *what)
+{
+    size_t i, start = vpds_count(s);
+    for (i = 0; i < n; i++) {
+        double x[2], t;
+        size_t k = vpds_count(s);
+        vpds_status e = vpds_next(s, 0, x, &t);
+        CHECK_MSG(e == VPDS_OK, "%s: event %zu: %s", what, i, vpds_last_error(s));
+        if (e != VPDS_OK) return;
+        if (k > 0 && (i < 12 || i % (n / 6) == 0 || i + 1 == n)) {
+            double oracle = gap_v9(vpds_points(s), k, lo, hi, r);
+            if (one_radius) /* the sample is the farthest point */
+                CHECK_MSG(fabs(nearest(vpds_points(s), k, x) / (t * r) - 1) < 1e-10,
+                          "%s: event %zu at %.17g from the set, t r %.17g", what, i, nearest(vpds_points(s), k, x), t * r);
+            CHECK_MSG(fabs(oracle / (t * r) - 1) < 1e-9, "%s: event %zu (of %zu samples): t r %.17g, version 9 %.17g",
+                      what, i, k, t * r, oracle);
+        }
+    }
+    CHECK(vpds_count(s) == start + n);
+}
+
+static vpds_sampler *make(const double *lo, const double *hi, double r, double inhibition, uint64_t seed)
+{
+    vpds_desc desc = vpds_default_desc();
+    vpds_sampler *s = NULL;
+    desc.lo = lo;
+    desc.hi = hi;
+    desc.radius = r;
+    desc.inhibition = inhibition;
+    desc.seed = seed;
+    CHECK(vpds_create(&desc, &s) == VPDS_OK);
+    return s;
+}
+
+int main(void)
+{
+    static const double unit_lo[2] = {0, 0}, unit_hi[2] = {1, 1};
+    static const double long_lo[2] = {-1, 0.5}, long_hi[2] = {3, 1.25};
+    size_t n;
+    vpds_sampler *s;
+    quick = getenv("VPDS_TEST_QUICK") != NULL;
+    check_triangulations();
+    for (n = 1; n <= 40; n++) check_farthest(n, unit_lo, unit_hi, quick ? 1 : 4);
+    check_farthest(500, unit_lo, unit_hi, quick ? 1 : 5);
+    check_farthest(200, long_lo, long_hi, quick ? 1 : 5);
+
+    s = make(unit_lo, unit_hi, 0.05, 1, 3);
+    if (s) check_stream_oracle(s, quick ? 300 : 3000, unit_lo, unit_hi, 0.05, 1, "unit square");
+    vpds_destroy(s);
+    s = make(long_lo, long_hi, 0.05, 1, 4);
+    if (s) check_stream_oracle(s, quick ? 300 : 2000, long_lo, long_hi, 0.05, 1, "long box");
+    vpds_destroy(s);
+    s = make(unit_lo, unit_hi, 0.05, 0.5, 5);
+    if (s) check_stream_oracle(s, quick ? 200 : 1000, unit_lo, unit_hi, 0.05, 0, "two radii");
+    vpds_destroy(s);
+    s = make(unit_lo, unit_hi, 0.03, 1, 6); /* after a maximal run */
+    if (s) {
+        CHECK(vpds_run(s) == VPDS_OK);
+        check_stream_oracle(s, quick ? 100 : 600, unit_lo, unit_hi, 0.03, 1, "after a run");
+    }
+    vpds_destroy(s);
+    s = make(unit_lo, unit_hi, 0.05, 1, 7); /* a fixed point outside the box: the regions */
+    if (s) {
+        static const double outside[2] = {1.02, 0.5}, inside[2] = {0.25, 0.25};
+        check_stream_oracle(s, 50, unit_lo, unit_hi, 0.05, 1, "before a fixed point outside");
+        CHECK(vpds_add_points(s, inside, NULL, 1) == VPDS_OK);
+        check_stream_oracle(s, 50, unit_lo, unit_hi, 0.05, 1, "after a fixed point inside");
+        CHECK(vpds_add_points(s, outside, NULL, 1) == VPDS_OK);
+        check_stream_oracle(s, 100, unit_lo, unit_hi, 0.05, 1, "after a fixed point outside");
+    }
+    vpds_destroy(s);
+    CHECK_DONE();
+}
