@@ -4,6 +4,7 @@
  *        | tworamp3 VERSION [INHIBITION] (3D two radii R_f = INHIBITION R_c (0.5), r = 0.03 + 0.12 x0, periodic axes 1 and 2,
  *          rule bigger, at algorithm_version VERSION: a fuzz input's workload)
  *        | annulus RADIUS (a domain) | stream DIM RADIUS N STEPS [VERSION [INHIBITION]] (prints one line per N/STEPS samples: the cost along n)
+ *        | afterrun DIM RADIUS N [VERSION] (N events of the stream after a maximal run)
  *        | streamramp RULE N STEPS [VERSION] (the same with the ramp r = 0.001 + 0.3 x0 on the unit square)
  *        | threads DIM RADIUS TILES THREADS (vpds_tiling_run of TILES per axis on THREADS threads)
  *        | rampthreads RULE TILES_X TILES_Y THREADS (the ramp's box tiled so, its sizing thread-safe)
@@ -80,6 +81,27 @@ static int stream(vpds_desc *d, size_t n, size_t steps)
             t_step = now_s;
         }
     }
+    vpds_destroy(s);
+    return 0;
+}
+
+/* N events of the stream after a maximal run (its time apart): what an engine does that
+ * refines a world it has made. */
+static int stream_after_run(vpds_desc *d, size_t n)
+{
+    vpds_sampler *s;
+    double x[VPDS_MAX_DIM], t, t0 = now(), t1;
+    size_t i;
+    if (vpds_create(d, &s) != VPDS_OK || vpds_run(s) != VPDS_OK) return 1;
+    t1 = now();
+    for (i = 0; i < n; i++)
+        if (vpds_next(s, 0.0, x, &t) != VPDS_OK) {
+            fprintf(stderr, "afterrun: %s\n", vpds_last_error(s));
+            return 1;
+        }
+    /* name samples_of_the_run run_seconds stream_seconds peak_bytes last_t */
+    printf("afterrun %zu %.6f %.6f %zu %.6g\n", vpds_count(s) - n, t1 - t0, now() - t1,
+           vpds_get_stats(s).peak_bytes, t);
     vpds_destroy(s);
     return 0;
 }
@@ -353,6 +375,12 @@ int main(int argc, char **argv)
         if (argc >= 8) d.inhibition = atof(argv[7]);
         return stream(&d, (size_t)atof(argv[4]), (size_t)atoi(argv[5]));
     }
+    if (argc >= 5 && !strcmp(argv[1], "afterrun")) {
+        d.dim = atoi(argv[2]);
+        d.radius = atof(argv[3]);
+        if (argc >= 6) d.algorithm_version = (uint32_t)atoi(argv[5]);
+        return stream_after_run(&d, (size_t)atof(argv[4]));
+    }
     if (argc >= 5 && !strcmp(argv[1], "streamramp")) {
         /* the stream with the ramp r = 0.001 + 0.3 x0 on the unit square, one rule */
         d.sizing = ramp;
@@ -411,6 +439,6 @@ int main(int argc, char **argv)
         return 0;
     }
     fprintf(stderr, "usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION | ramp RULE | rampthreads RULE TX TY THREADS"
-                    " | tworamp3 VERSION | floor N DIM | stream DIM RADIUS N STEPS [VERSION [INHIBITION]] | streamramp RULE N STEPS [VERSION] | mesh square|sphere RADIUS | meshstream N [VERSION] | meshfile FILE RADIUS\n");
+                    " | tworamp3 VERSION | floor N DIM | stream DIM RADIUS N STEPS [VERSION [INHIBITION]] | afterrun DIM RADIUS N [VERSION] | streamramp RULE N STEPS [VERSION] | mesh square|sphere RADIUS | meshstream N [VERSION] | meshfile FILE RADIUS\n");
     return 2;
 }

@@ -48,8 +48,7 @@ int vpdsi_dt_init(vpdsi_dt *dt, vpdsi_mem *m, const double *lo, const double *hi
     }
     for (k = 0; k < 6; k++) dt->far_x[k] = c[k % 2] + 3 * diag * dir[k];
     if (vpdsi_mem_reserve(m, (void **)&dt->tv, &dt->cap_tv, 3 * 64, sizeof(uint32_t)) ||
-        vpdsi_mem_reserve(m, (void **)&dt->tn, &dt->cap_tn, 3 * 64, sizeof(uint32_t)) ||
-        vpdsi_mem_reserve(m, (void **)&dt->mark, &dt->cap_mark, 64, sizeof(uint32_t))) {
+        vpdsi_mem_reserve(m, (void **)&dt->tn, &dt->cap_tn, 3 * 64, sizeof(uint32_t))) {
         vpdsi_dt_release(dt, m);
         return -1;
     }
@@ -57,7 +56,6 @@ int vpdsi_dt_init(vpdsi_dt *dt, vpdsi_mem *m, const double *lo, const double *hi
         dt->tv[k] = (uint32_t)k;
         dt->tn[k] = VPDSI_DT_NONE;
     }
-    dt->mark[0] = 0;
     dt->n_tri = 1;
     return 0;
 }
@@ -66,7 +64,6 @@ void vpdsi_dt_release(vpdsi_dt *dt, vpdsi_mem *m)
 {
     vpdsi_mem_free(m, dt->tv, dt->cap_tv * sizeof(uint32_t));
     vpdsi_mem_free(m, dt->tn, dt->cap_tn * sizeof(uint32_t));
-    vpdsi_mem_free(m, dt->mark, dt->cap_mark * sizeof(uint32_t));
     vpdsi_mem_free(m, dt->cavity, dt->cap_cavity * sizeof(uint32_t));
     vpdsi_mem_free(m, dt->rim, dt->cap_rim * sizeof(uint32_t));
     vpdsi_mem_free(m, dt->fresh, dt->cap_fresh * sizeof(uint32_t));
@@ -105,7 +102,16 @@ static int dt_push_cavity(vpdsi_dt *dt, vpdsi_mem *m, uint32_t t)
     if (vpdsi_mem_reserve(m, (void **)&dt->cavity, &dt->cap_cavity, dt->n_cavity + 1, sizeof(uint32_t)))
         return -1;
     dt->cavity[dt->n_cavity++] = t;
-    dt->mark[t] = dt->stamp;
+    return 0;
+}
+
+/* Whether triangle t is among cavity[from, to): a cavity holds a few triangles, so a scan
+ * costs less than a mark per triangle (memory, and a cache miss). */
+static int dt_among(const vpdsi_dt *dt, size_t from, size_t to, uint32_t t)
+{
+    size_t j;
+    for (j = from; j < to; j++)
+        if (dt->cavity[j] == t) return 1;
     return 0;
 }
 
@@ -114,10 +120,6 @@ static int dt_push_cavity(vpdsi_dt *dt, vpdsi_mem *m, uint32_t t)
 static int dt_grow_cavity(vpdsi_dt *dt, vpdsi_mem *m, const double *pts, const double *p, uint32_t t)
 {
     size_t j;
-    if (++dt->stamp == 0) { /* the stamps wrapped: clear them once */
-        memset(dt->mark, 0, dt->n_tri * sizeof(uint32_t));
-        dt->stamp = 1;
-    }
     dt->n_cavity = 0;
     if (dt_push_cavity(dt, m, t)) return -1;
     for (j = 0; j < dt->n_cavity; j++) {
@@ -126,7 +128,7 @@ static int dt_grow_cavity(vpdsi_dt *dt, vpdsi_mem *m, const double *pts, const d
         for (i = 0; i < 3; i++) {
             uint32_t u = dt->tn[3 * (size_t)c + (size_t)i];
             const uint32_t *w;
-            if (u == VPDSI_DT_NONE || dt->mark[u] == dt->stamp) continue;
+            if (u == VPDSI_DT_NONE || dt_among(dt, 0, dt->n_cavity, u)) continue;
             w = dt->tv + 3 * (size_t)u;
             if (dt_incircle(vpdsi_dt_point(dt, pts, w[0]), vpdsi_dt_point(dt, pts, w[1]),
                             vpdsi_dt_point(dt, pts, w[2]), p) > 0 &&
@@ -157,22 +159,19 @@ static int dt_repair(vpdsi_dt *dt, vpdsi_mem *m, const double *pts, const double
     const double *b = vpdsi_dt_point(dt, pts, dt->tv[3 * (size_t)c + (size_t)(i + 2) % 3]);
     size_t j, kept;
     if (at == 0 || (o == 0 && dt_between(a, b, p))) return u == VPDSI_DT_NONE ? -2 : dt_push_cavity(dt, m, u);
-    dt->mark[c] = 0;
     dt->cavity[at] = dt->cavity[--dt->n_cavity];
-    /* the triangles still reached from the first through the cavity stay in it */
-    for (j = 1; j < dt->n_cavity; j++) dt->mark[dt->cavity[j]] = 0;
+    /* the triangles still reached from the first through the cavity stay in it: [0, kept) */
     for (kept = 1, j = 0; j < kept; j++) {
         uint32_t t = dt->cavity[j];
         int w;
         for (w = 0; w < 3; w++) {
             uint32_t v = dt->tn[3 * (size_t)t + (size_t)w];
             size_t q;
-            if (v == VPDSI_DT_NONE || dt->mark[v] == dt->stamp) continue;
+            if (v == VPDSI_DT_NONE || dt_among(dt, 0, kept, v)) continue;
             for (q = kept; q < dt->n_cavity && dt->cavity[q] != v; q++) {}
             if (q == dt->n_cavity) continue;
             dt->cavity[q] = dt->cavity[kept];
             dt->cavity[kept++] = v;
-            dt->mark[v] = dt->stamp;
         }
     }
     dt->n_cavity = kept;
@@ -194,7 +193,7 @@ again:
             uint32_t u = dt->tn[3 * (size_t)c + (size_t)i];
             uint32_t a = dt->tv[3 * (size_t)c + (size_t)(i + 1) % 3], b = dt->tv[3 * (size_t)c + (size_t)(i + 2) % 3];
             double o;
-            if (u != VPDSI_DT_NONE && dt->mark[u] == dt->stamp) continue;
+            if (u != VPDSI_DT_NONE && dt_among(dt, 0, dt->n_cavity, u)) continue;
             o = dt_orient(vpdsi_dt_point(dt, pts, a), vpdsi_dt_point(dt, pts, b), p);
             if (o <= 0) {
                 int e = ++repairs > VPDSI_DT_REPAIRS ? -2 : dt_repair(dt, m, pts, p, j, i, o);
@@ -240,7 +239,6 @@ static void dt_fan(vpdsi_dt *dt, uint32_t v)
         dt->tv[3 * s + 1] = a;
         dt->tv[3 * s + 2] = b;
         dt->tn[3 * s] = u;
-        dt->mark[s] = 0;
         if (u != VPDSI_DT_NONE) { /* u's edge (b, a) now faces s */
             int i;
             for (i = 0; i < 3; i++) {
@@ -265,10 +263,8 @@ int vpdsi_dt_insert(vpdsi_dt *dt, vpdsi_mem *m, const double *pts, size_t index,
     int i, e;
     if (index >= VPDSI_DT_MAX_POINTS) return -2;
     if (vpdsi_mem_reserve(m, (void **)&dt->tv, &dt->cap_tv, 3 * (dt->n_tri + 2), sizeof(uint32_t)) ||
-        vpdsi_mem_reserve(m, (void **)&dt->tn, &dt->cap_tn, 3 * (dt->n_tri + 2), sizeof(uint32_t)) ||
-        vpdsi_mem_reserve(m, (void **)&dt->mark, &dt->cap_mark, dt->n_tri + 2, sizeof(uint32_t)))
+        vpdsi_mem_reserve(m, (void **)&dt->tn, &dt->cap_tn, 3 * (dt->n_tri + 2), sizeof(uint32_t)))
         return -1;
-    dt->mark[dt->n_tri] = dt->mark[dt->n_tri + 1] = 0;
     t = dt_locate(dt, pts, p, hint);
     if (t == VPDSI_DT_NONE) return -2;
     for (i = 0; i < 3; i++) {

@@ -18,8 +18,6 @@ typedef struct vpdsi_dt {
     uint32_t *tv;             /* 3 vertices per triangle, counter-clockwise */
     uint32_t *tn;             /* tn[3t + i]: the triangle across the edge opposite tv[3t + i] */
     size_t n_tri, cap_tv, cap_tn;
-    uint32_t *mark; size_t cap_mark; /* the insert's stamp on the triangles of its cavity */
-    uint32_t stamp;
     uint32_t *cavity; size_t n_cavity, cap_cavity;
     /* after an insert: the cavity's edges (a, b, the triangle outside) and the new triangles */
     uint32_t *rim; size_t n_rim, cap_rim;

@@ -3,6 +3,7 @@
  * so that the order is a function of the triangulation alone). */
 #include "voids.h"
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 void vpdsi_voids_init(vpdsi_voids *vd)
@@ -16,6 +17,7 @@ void vpdsi_voids_release(vpdsi_voids *vd, vpdsi_mem *m)
     vpdsi_mem_free(m, vd->key, vd->cap_key * sizeof(double));
     vpdsi_mem_free(m, vd->tri, vd->cap_tri * sizeof(uint32_t));
     vpdsi_mem_free(m, vd->pos, vd->cap_pos * sizeof(uint32_t));
+    vpdsi_mem_free(m, vd->batch, vd->cap_batch * sizeof(uint64_t));
     vpdsi_voids_init(vd);
 }
 
@@ -199,37 +201,101 @@ static int vd_start(vpdsi_voids *vd, vpdsi_mem *m, const double *lo, const doubl
     return 0;
 }
 
+/* Insert sample i (in the box). */
+static int vd_insert(vpdsi_voids *vd, vpdsi_mem *m, const double *pts, size_t i)
+{
+    const vpdsi_dt *dt = &vd->dt;
+    const double *p = pts + 2 * i;
+    size_t before = dt->n_tri, j;
+    int e, k;
+    if (vd_reserve(vd, m)) return -1;
+    e = vpdsi_dt_insert(&vd->dt, m, pts, i, vd->hint);
+    if (e < 0) return e;
+    if (e == 0) {
+        for (j = before; j < dt->n_tri; j++) vd->pos[j] = VPDSI_DT_NONE;
+        for (j = 0; j < dt->n_rim; j++) {
+            uint32_t u = dt->rim[3 * j + 2];
+            vd_update(vd, pts, dt->fresh[j]);
+            if (u != VPDSI_DT_NONE) vd_update(vd, pts, u);
+        }
+    }
+    for (k = 0; k < 4; k++) {
+        double c[2], d2;
+        c[0] = k & 1 ? dt->hi[0] : dt->lo[0];
+        c[1] = k & 2 ? dt->hi[1] : dt->lo[1];
+        d2 = vd_dist2(c, p);
+        if (d2 < vd->corner_d2[k]) vd->corner_d2[k] = d2;
+    }
+    vd->hint = VPDSI_DT_NONE;
+    return 0;
+}
+
+/* Interleaves the bits of x and y (16 each). */
+static uint32_t vd_morton(uint32_t x, uint32_t y)
+{
+    uint32_t code = 0;
+    int b;
+    for (b = 15; b >= 0; b--) code = code << 2 | ((y >> b) & 1u) << 1 | ((x >> b) & 1u);
+    return code;
+}
+
+static int vd_cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The samples [vd->n, n) as a batch in Morton order of a 2^16 grid over the box; -2 when one
+ * lies outside the box. */
+static int vd_make_batch(vpdsi_voids *vd, vpdsi_mem *m, const double *pts, size_t n)
+{
+    const vpdsi_dt *dt = &vd->dt;
+    size_t i, count = n - vd->n;
+    if (vpdsi_mem_reserve(m, (void **)&vd->batch, &vd->cap_batch, count, sizeof(uint64_t))) return -1;
+    for (i = 0; i < count; i++) {
+        const double *p = pts + 2 * (vd->n + i);
+        uint32_t q[2];
+        int k;
+        if (!vd_in_box(dt, p)) return -2;
+        for (k = 0; k < 2; k++) {
+            double u = (p[k] - dt->lo[k]) / (dt->hi[k] - dt->lo[k]) * 65536.0;
+            q[k] = u >= 65535.0 ? 65535u : (uint32_t)u;
+        }
+        vd->batch[i] = (uint64_t)vd_morton(q[0], q[1]) << 32 | (uint64_t)(vd->n + i);
+    }
+    qsort(vd->batch, count, sizeof(uint64_t), vd_cmp_u64);
+    vd->n_batch = count;
+    vd->at = 0;
+    vd->n = n;
+    return 0;
+}
+
 int vpdsi_voids_sync(vpdsi_voids *vd, vpdsi_mem *m, const double *lo, const double *hi,
                      const double *pts, size_t n)
 {
+    int e;
+    if (n > VPDSI_DT_MAX_POINTS) return -2;
     if (!vd->ready && vd_start(vd, m, lo, hi)) return -1;
-    while (vd->n < n) {
-        const double *p = pts + 2 * vd->n;
-        size_t before = vd->dt.n_tri, j;
-        int e, k;
-        if (!vd_in_box(&vd->dt, p)) return -2;
-        if (vd_reserve(vd, m)) return -1;
-        e = vpdsi_dt_insert(&vd->dt, m, pts, vd->n, vd->hint);
-        if (e < 0) return e;
-        if (e == 0) {
-            for (j = before; j < vd->dt.n_tri; j++) vd->pos[j] = VPDSI_DT_NONE;
-            for (j = 0; j < vd->dt.n_rim; j++) {
-                uint32_t u = vd->dt.rim[3 * j + 2];
-                vd_update(vd, pts, vd->dt.fresh[j]);
-                if (u != VPDSI_DT_NONE) vd_update(vd, pts, u);
-            }
+    for (;;) {
+        while (vd->at < vd->n_batch) { /* a batch first, to its end */
+            if ((e = vd_insert(vd, m, pts, (size_t)(vd->batch[vd->at] & 0xffffffffu))) != 0) return e;
+            vd->at++;
         }
-        for (k = 0; k < 4; k++) {
-            double c[2], d2;
-            c[0] = k & 1 ? hi[0] : lo[0];
-            c[1] = k & 2 ? hi[1] : lo[1];
-            d2 = vd_dist2(c, p);
-            if (d2 < vd->corner_d2[k]) vd->corner_d2[k] = d2;
+        if (vd->n_batch) {
+            vpdsi_mem_free(m, vd->batch, vd->cap_batch * sizeof(uint64_t));
+            vd->batch = NULL;
+            vd->cap_batch = vd->n_batch = vd->at = 0;
         }
-        vd->hint = VPDSI_DT_NONE;
+        if (vd->n + 1 < n) {
+            if ((e = vd_make_batch(vd, m, pts, n)) != 0) return e;
+            continue;
+        }
+        if (vd->n == n) return 0;
+        if (!vd_in_box(&vd->dt, pts + 2 * vd->n)) return -2;
+        if ((e = vd_insert(vd, m, pts, vd->n)) != 0) return e;
         vd->n++;
+        return 0;
     }
-    return 0;
 }
 
 double vpdsi_voids_farthest(vpdsi_voids *vd, const double *pts, double *y)

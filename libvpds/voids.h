@@ -18,12 +18,16 @@ typedef struct vpdsi_voids {
     size_t count;
     uint32_t *pos; size_t cap_pos; /* each triangle's place in the heap, or VPDSI_DT_NONE */
     uint32_t hint;            /* the triangle of the last farthest point: the next walk's start */
+    /* samples that came in a batch (a run's, fixed points), inserted in Morton order so that
+     * each walk is short: (key << 32 | index), the next at batch[at] */
+    uint64_t *batch; size_t n_batch, at, cap_batch;
 } vpdsi_voids;
 
 void vpdsi_voids_init(vpdsi_voids *vd);
 void vpdsi_voids_release(vpdsi_voids *vd, vpdsi_mem *m);
-/* Insert the samples [vd->n, n) of the box [lo, hi] (points pts, 2 per sample). Returns 0,
- * -1 on OOM (the samples before the failing one are in), or -2 when a sample lies outside
+/* Insert the samples [vd->n, n) of the box [lo, hi] (points pts, 2 per sample), several at
+ * once in Morton order. Returns 0, -1 on OOM (a retry goes on in the same order, so that the
+ * triangulation is the one a sync that never failed makes), or -2 when a sample lies outside
  * the box or round-off broke a cavity: the triangulation then no longer serves. */
 int vpdsi_voids_sync(vpdsi_voids *vd, vpdsi_mem *m, const double *lo, const double *hi,
                      const double *pts, size_t n);

@@ -9,6 +9,7 @@
  *   and after a fixed point outside the box (where the regions take over), each event's t is
  *   the largest gap version 9 finds for the points before it. */
 #include "check.h"
+#include "failing_alloc.h"
 #include "vpds.h"
 #include "voids.h"
 #include <math.h>
@@ -207,6 +208,51 @@ static void check_stream_oracle(vpds_sampler *s, size_t n, const double *lo, con
     CHECK(vpds_count(s) == start + n);
 }
 
+/* After a run, each allocation of the stream (the run's samples go into the triangulation in
+ * one batch, in Morton order) fails once in turn: the retry goes on, and the events are those
+ * of a stream without failures. */
+static void check_allocation_failures(void)
+{
+    enum { N = 40 };
+    vpds_desc d = vpds_default_desc();
+    double ref[2 * N], ref_t[N], x[2 * N], t[N];
+    failing_alloc fa;
+    vpds_sampler *s = NULL;
+    size_t k, i, base, total, failures = 0;
+    d.radius = 0.02;
+    d.seed = 11;
+    d.allocator.alloc = fa_alloc;
+    d.allocator.free = fa_free;
+    d.allocator.user = &fa;
+    memset(&fa, 0, sizeof fa);
+    CHECK(vpds_create(&d, &s) == VPDS_OK && vpds_run(s) == VPDS_OK);
+    base = fa.calls;
+    for (i = 0; i < N; i++) CHECK(vpds_next(s, 0, ref + 2 * i, ref_t + i) == VPDS_OK);
+    total = fa.calls - base;
+    vpds_destroy(s);
+    for (k = 1; k <= total; k++) {
+        vpds_status st = VPDS_OK;
+        memset(&fa, 0, sizeof fa);
+        CHECK(vpds_create(&d, &s) == VPDS_OK && vpds_run(s) == VPDS_OK);
+        fa.fail_at = fa.calls + k;
+        for (i = 0; i < N;) {
+            st = vpds_next(s, 0, x + 2 * i, t + i);
+            if (st == VPDS_ERR_OUT_OF_MEMORY) {
+                failures++;
+                continue;
+            }
+            if (st != VPDS_OK) break;
+            i++;
+        }
+        CHECK_MSG(st == VPDS_OK && memcmp(x, ref, sizeof x) == 0 && memcmp(t, ref_t, sizeof t) == 0,
+                  "the stream after a run differs after failing allocation %zu", k);
+        vpds_destroy(s);
+        CHECK_MSG(fa.live == 0, "leak after failing allocation %zu", k);
+    }
+    CHECK(failures > 0);
+    printf("stream after a run, allocation failures: %zu allocations, %zu failed once each\n", total, failures);
+}
+
 static vpds_sampler *make(const double *lo, const double *hi, double r, double inhibition, uint64_t seed)
 {
     vpds_desc desc = vpds_default_desc();
@@ -257,5 +303,6 @@ int main(void)
         check_stream_oracle(s, 100, unit_lo, unit_hi, 0.05, 1, "after a fixed point outside");
     }
     vpds_destroy(s);
+    check_allocation_failures();
     CHECK_DONE();
 }
