@@ -301,7 +301,7 @@ def stream_rows() -> None:
     """The continuous stream (vpds_next) from empty: samples/s and the per-sample cost along n,
     beside a maximal run of about as many samples and beside a farthest-point sampler of a
     candidate cloud from PyPI (no registry package streams a continuous farthest-point order)."""
-    for dim, n_total in ((2, 1e4 if QUICK else 1e5), (3, 3e3 if QUICK else 1e5)):
+    for dim, n_total in ((2, 1e4 if QUICK else 1e6), (3, 3e3 if QUICK else 1e5)):
         steps = 10
         lines = sh([str(OUT / "bench"), "stream", str(dim), "1", f"{n_total:g}", str(steps)])
         pts = [ln.split() for ln in lines.splitlines()]

@@ -85,7 +85,8 @@ vpds_status vpdsi_store_radii(vpdsi_store *st, const double *x, size_t n, double
     return vpdsi_sizing_eval(&st->sizing, x, n, out, st->err, sizeof st->err);
 }
 
-vpds_status vpdsi_store_reserve(vpdsi_store *st, size_t more)
+/* Room for `more` samples; the kd-tree's too when `index` (it keeps up with the samples). */
+static vpds_status store_reserve(vpdsi_store *st, size_t more, int index)
 {
     size_t need = st->n + more, want, nx;
     vpdsi_mem *m = st->mem;
@@ -100,13 +101,23 @@ vpds_status vpdsi_store_reserve(vpdsi_store *st, size_t more)
         vpdsi_mem_reserve(m, (void **)&st->r, &st->cap_r, want, sizeof(double)) ||
         vpdsi_mem_reserve(m, (void **)&st->t, &st->cap_t, want, sizeof(double)) ||
         vpdsi_mem_reserve(m, (void **)&st->flags, &st->cap_flags, want, 1) ||
-        (!st->grid_mode && !st->ogrid_mode &&
+        (index && !st->grid_mode && !st->ogrid_mode &&
          vpdsi_kd_reserve(&st->tree, m, need, need - st->tree_n)) ||
         (st->ogrid_mode && vpdsi_ogrid_reserve(&st->ogrid, m, need, more))) {
         vpdsi_store_error(st, "out of memory for %zu samples", need);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
     return VPDS_OK;
+}
+
+vpds_status vpdsi_store_reserve(vpdsi_store *st, size_t more)
+{
+    return store_reserve(st, more, 1);
+}
+
+vpds_status vpdsi_store_reserve_lagging(vpdsi_store *st, size_t more)
+{
+    return store_reserve(st, more, 0);
 }
 
 /* Samples the tree takes per reserve: an insert may split a leaf (two nodes), so a reserve
@@ -214,11 +225,20 @@ void vpdsi_store_append(vpdsi_store *st, const double *x, double r, double t, ui
     } else if (st->ogrid_mode) {
         vpdsi_kd_samples v = vpdsi_store_view(st);
         vpdsi_ogrid_insert(&st->ogrid, &v, (int32_t)(st->n - 1));
-    } else {
+    } else if (st->tree_n + 1 == st->n) { /* a lagging tree stays behind until synced */
         vpdsi_kd_samples v = vpdsi_store_view(st);
         vpdsi_kd_insert(&st->tree, &v, (int32_t)(st->n - 1));
         st->tree_n = st->n;
     }
+}
+
+void vpdsi_store_append_lagging(vpdsi_store *st, const double *x, double r, double t, uint8_t flags)
+{
+    memcpy(st->x + st->n * (size_t)st->dim, x, (size_t)st->dim * sizeof(double));
+    st->r[st->n] = r;
+    st->t[st->n] = t;
+    st->flags[st->n] = flags;
+    st->n++;
 }
 
 int vpdsi_store_has_samples(const vpdsi_store *st)

@@ -54,8 +54,13 @@ vpds_status vpdsi_store_radii(vpdsi_store *st, const double *x, size_t n, double
 vpds_status vpdsi_store_reserve(vpdsi_store *st, size_t more);
 /* Insert samples [tree_n, n) into the kd-tree (before kd-tree queries after grid mode). */
 vpds_status vpdsi_store_sync_tree(vpdsi_store *st);
-/* Append and index a sample (after vpdsi_store_reserve). */
+/* Append and index a sample (after vpdsi_store_reserve); a kd-tree that lags stays behind. */
 void vpdsi_store_append(vpdsi_store *st, const double *x, double r, double t, uint8_t flags);
+/* The same without the kd-tree (no grid in use): it lags until vpdsi_store_sync_tree, and a
+ * reserve for it holds no room in the tree. For an algorithm that keeps its own index (the 2D
+ * stream's triangulation), so that samples are not indexed twice. */
+vpds_status vpdsi_store_reserve_lagging(vpdsi_store *st, size_t more);
+void vpdsi_store_append_lagging(vpdsi_store *st, const double *x, double r, double t, uint8_t flags);
 /* Index the samples (dim <= 3) with the octave grid (radii up to about top) until use_tree or
  * drop_index; queries then go through vpdsi_store_conflict and vpdsi_store_gather. A box too
  * wide for the grid's cells keeps the kd-tree (synced). On failure the store is left with no

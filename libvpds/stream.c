@@ -892,7 +892,8 @@ static vpds_status event_sample(const vpdsi_ctx *ctx, double t, const double *y,
 static int voids_apply(const vpdsi_ctx *ctx)
 {
     return ctx->pb->algorithm >= 10 && ctx->pb->dim == 2 && !ctx->pb->any_periodic &&
-           ctx->st->sizing.kind == VPDSI_SIZING_CONSTANT && !ctx->dom->fn;
+           ctx->st->sizing.kind == VPDSI_SIZING_CONSTANT && !ctx->dom->fn && !ctx->st->grid_mode &&
+           !ctx->st->ogrid_mode;
 }
 
 /* One event from the Voronoi diagram (after a store reserve, with a sample in the store).
@@ -926,12 +927,13 @@ static vpds_status voids_event(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_
     t = sqrt(g2) / (ctx->pb->coverage * ry);
     if (t > t_cap) t = t_cap;
     if (t <= t_min) return VPDS_STREAM_END;
+    /* the draw near y reads the kd-tree (the triangulation indexes the samples otherwise) */
     if (ctx->pb->two_radii && (e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
     if ((e = event_sample(ctx, t, y, x, &rx)) != VPDS_OK) {
         *ctx->rng = start;
         return e;
     }
-    vpdsi_store_append(st, x, rx, t, 0);
+    vpdsi_store_append_lagging(st, x, rx, t, 0);
     ctx->stats->accepted++;
     memcpy(x_out, x, sizeof x);
     *t_out = t;
@@ -948,7 +950,7 @@ vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_m
     vpds_status e;
     if (st->n > 0 && !sm->voids_off && voids_apply(ctx)) {
         int served;
-        if ((e = vpdsi_store_reserve(st, 1)) != VPDS_OK) return e;
+        if ((e = vpdsi_store_reserve_lagging(st, 1)) != VPDS_OK) return e;
         e = voids_event(sm, ctx, t_min, t_cap, x_out, t_out, &served);
         if (served) return e;
     }

@@ -303,6 +303,30 @@ int main(void)
         check_stream_oracle(s, 100, unit_lo, unit_hi, 0.05, 1, "after a fixed point outside");
     }
     vpds_destroy(s);
+    /* after a run, a fixed point outside: the regions take over and read the kd-tree, which the
+     * triangulation's events left behind; then a refinement keeps off every sample */
+    s = make(unit_lo, unit_hi, 0.03, 1, 8);
+    if (s) {
+        static const double outside[2] = {-0.01, 0.5};
+        size_t i, j, n_fixed, bad = 0;
+        double tau;
+        CHECK(vpds_run(s) == VPDS_OK);
+        check_stream_oracle(s, 100, unit_lo, unit_hi, 0.03, 1, "after a run (2)");
+        n_fixed = vpds_count(s);
+        CHECK(vpds_add_points(s, outside, NULL, 1) == VPDS_OK);
+        check_stream_oracle(s, 100, unit_lo, unit_hi, 0.03, 1, "after a run and a fixed point outside");
+        tau = 0.7 * vpds_scales(s)[vpds_count(s) - 1];
+        CHECK(vpds_refine(s, tau) == VPDS_OK);
+        n = vpds_count(s);
+        for (j = 1; j < n; j++)
+            for (i = 0; i < j; i++) {
+                const double *p = vpds_points(s);
+                double d2 = (p[2 * i] - p[2 * j]) * (p[2 * i] - p[2 * j]) + (p[2 * i + 1] - p[2 * j + 1]) * (p[2 * i + 1] - p[2 * j + 1]);
+                if (i != n_fixed && j != n_fixed && sqrt(d2) < tau * 0.03 * (1 - 1e-12)) bad++;
+            }
+        CHECK_MSG(bad == 0, "after a stream and a refinement: %zu pairs closer than tau r", bad);
+    }
+    vpds_destroy(s);
     check_allocation_failures();
     CHECK_DONE();
 }
