@@ -75,8 +75,10 @@ extern "C" {
  * Delaunay triangulation that each sample changes only around itself, where version 9
  * searched regions of the box: the same largest gaps to round-off, other bits, and where two
  * points are equally far another may come first (other points for vpds_next in 2D; everything
- * else gives the points of version 9). */
-#define VPDS_ALGORITHM_VERSION 10
+ * else gives the points of version 9). 11: the same in 3D, from the Delaunay tetrahedralisation
+ * and, along the box's edges, the lower envelope of the samples' distances (other points for
+ * vpds_next in 3D; everything else gives the points of version 10). */
+#define VPDS_ALGORITHM_VERSION 11
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 16
 /* Relative tolerance eps of the continuous stream (vpds_next): each t it reports is an upper

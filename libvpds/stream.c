@@ -27,6 +27,7 @@ void vpdsi_stream_init(vpdsi_stream *sm)
     memset(sm, 0, sizeof *sm);
     vpdsi_region_heap_init(&sm->regions, 0);
     vpdsi_voids_init(&sm->voids);
+    vpdsi_voids3_init(&sm->voids3);
 }
 
 void vpdsi_stream_release(vpdsi_stream *sm, vpdsi_mem *m)
@@ -41,6 +42,7 @@ void vpdsi_stream_release(vpdsi_stream *sm, vpdsi_mem *m)
     vpdsi_mem_free(m, sm->lists, sm->cap_lists * sizeof(int32_t));
     vpdsi_mem_free(m, sm->near, sm->cap_near * sizeof(int32_t));
     vpdsi_voids_release(&sm->voids, m);
+    vpdsi_voids3_release(&sm->voids3, m);
     vpdsi_stream_init(sm);
 }
 
@@ -888,10 +890,12 @@ static vpds_status event_sample(const vpdsi_ctx *ctx, double t, const double *y,
 }
 
 /* Version 10 finds the farthest point from the Voronoi diagram of the samples (voids.c) with
- * one radius in an open 2D box: exact, and changed only around each new sample. */
+ * one radius in an open 2D box, version 11 in 3D too (voids3.c): exact, and changed only
+ * around each new sample. */
 static int voids_apply(const vpdsi_ctx *ctx)
 {
-    return ctx->pb->algorithm >= 10 && ctx->pb->dim == 2 && !ctx->pb->any_periodic &&
+    return ((ctx->pb->algorithm >= 10 && ctx->pb->dim == 2) || (ctx->pb->algorithm >= 11 && ctx->pb->dim == 3)) &&
+           !ctx->pb->any_periodic &&
            ctx->st->sizing.kind == VPDSI_SIZING_CONSTANT && !ctx->dom->fn && !ctx->st->grid_mode &&
            !ctx->st->ogrid_mode;
 }
@@ -904,17 +908,20 @@ static vpds_status voids_event(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_
 {
     vpdsi_store *st = ctx->st;
     vpdsi_rng start = *ctx->rng;
-    double y[2], x[2], g2, ry, rx, t;
+    double y[3], x[3], g2, ry, rx, t;
     vpds_status e;
     size_t i;
-    int sync = 0;
+    int sync = 0, d = ctx->pb->dim;
     /* a fixed point of another radius makes g a weighted distance: the regions' search */
-    for (i = sm->voids.n; i < st->n && !sync; i++)
+    for (i = d == 2 ? sm->voids.n : sm->voids3.n; i < st->n && !sync; i++)
         if (st->r[i] != st->sizing.radius) sync = -2;
-    if (!sync) sync = vpdsi_voids_sync(&sm->voids, ctx->mem, ctx->pb->lo, ctx->pb->hi, st->x, st->n);
+    if (!sync)
+        sync = d == 2 ? vpdsi_voids_sync(&sm->voids, ctx->mem, ctx->pb->lo, ctx->pb->hi, st->x, st->n)
+                      : vpdsi_voids3_sync(&sm->voids3, ctx->mem, ctx->pb->lo, ctx->pb->hi, st->x, st->n);
     *served = sync != -2;
     if (sync == -2) {
         vpdsi_voids_release(&sm->voids, ctx->mem);
+        vpdsi_voids3_release(&sm->voids3, ctx->mem);
         sm->voids_off = 1;
         return VPDS_OK;
     }
@@ -922,7 +929,7 @@ static vpds_status voids_event(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_
         vpdsi_store_error(st, "out of memory for the stream's triangulation");
         return VPDS_ERR_OUT_OF_MEMORY;
     }
-    g2 = vpdsi_voids_farthest(&sm->voids, st->x, y);
+    g2 = d == 2 ? vpdsi_voids_farthest(&sm->voids, st->x, y) : vpdsi_voids3_farthest(&sm->voids3, st->x, y);
     if ((e = vpdsi_store_radius_at(st, y, &ry)) != VPDS_OK) return e;
     t = sqrt(g2) / (ctx->pb->coverage * ry);
     if (t > t_cap) t = t_cap;
@@ -935,7 +942,7 @@ static vpds_status voids_event(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_
     }
     vpdsi_store_append_lagging(st, x, rx, t, 0);
     ctx->stats->accepted++;
-    memcpy(x_out, x, sizeof x);
+    memcpy(x_out, x, (size_t)d * sizeof(double));
     *t_out = t;
     return VPDS_OK;
 }

@@ -5,6 +5,7 @@
 #include "context.h"
 #include "region_heap.h"
 #include "voids.h"
+#include "voids3.h"
 
 /* The box is cut into regions (cells of a lazily refined grid) in a max-heap keyed by an upper
  * bound of g = distance to the samples over coverage * f, the scale at which a point becomes
@@ -30,9 +31,11 @@ typedef struct vpdsi_stream {
     /* version 8: the samples that may be nearest in an open box of the search, one list per
      * split shared by its children, which filter it for theirs */
     int32_t *near; size_t n_near, cap_near;
-    /* version 10, one radius in 2D: the Voronoi diagram's candidates (voids.h), until a sample
-     * outside the box or round-off makes it give way to the regions (voids_off) */
+    /* version 10, one radius in 2D (11: and 3D): the Voronoi diagram's candidates (voids.h,
+     * voids3.h), until a sample outside the box or round-off makes it give way to the regions
+     * (voids_off) */
     vpdsi_voids voids;
+    vpdsi_voids3 voids3;
     int voids_off;
 } vpdsi_stream;
 

@@ -1,6 +1,5 @@
 /* The stream's farthest point in 2D from the Voronoi diagram (voids.h): one candidate per
- * Delaunay triangle, the triangles in an indexed max-heap (ties to the lower triangle index,
- * so that the order is a function of the triangulation alone). */
+ * Delaunay triangle, the triangles in an indexed max-heap (index_heap.h). */
 #include "voids.h"
 #include <math.h>
 #include <stdlib.h>
@@ -14,9 +13,7 @@ void vpdsi_voids_init(vpdsi_voids *vd)
 void vpdsi_voids_release(vpdsi_voids *vd, vpdsi_mem *m)
 {
     vpdsi_dt_release(&vd->dt, m);
-    vpdsi_mem_free(m, vd->key, vd->cap_key * sizeof(double));
-    vpdsi_mem_free(m, vd->tri, vd->cap_tri * sizeof(uint32_t));
-    vpdsi_mem_free(m, vd->pos, vd->cap_pos * sizeof(uint32_t));
+    vpdsi_index_heap_release(&vd->heap, m);
     vpdsi_mem_free(m, vd->batch, vd->cap_batch * sizeof(uint64_t));
     vpdsi_voids_init(vd);
 }
@@ -116,74 +113,16 @@ static double vd_candidate(const vpdsi_voids *vd, const double *pts, uint32_t t,
     return best;
 }
 
-/* ---- the indexed heap ---- */
-
-static int vd_above(const vpdsi_voids *vd, size_t i, size_t j)
-{
-    return vd->key[i] > vd->key[j] || (vd->key[i] == vd->key[j] && vd->tri[i] < vd->tri[j]);
-}
-
-static void vd_swap(vpdsi_voids *vd, size_t i, size_t j)
-{
-    double k = vd->key[i];
-    uint32_t t = vd->tri[i];
-    vd->key[i] = vd->key[j];
-    vd->tri[i] = vd->tri[j];
-    vd->key[j] = k;
-    vd->tri[j] = t;
-    vd->pos[vd->tri[i]] = (uint32_t)i;
-    vd->pos[vd->tri[j]] = (uint32_t)j;
-}
-
-static void vd_sift(vpdsi_voids *vd, size_t i)
-{
-    while (i > 0 && vd_above(vd, i, (i - 1) / 2)) {
-        vd_swap(vd, i, (i - 1) / 2);
-        i = (i - 1) / 2;
-    }
-    for (;;) {
-        size_t c = 2 * i + 1, best = i;
-        if (c < vd->count && vd_above(vd, c, best)) best = c;
-        if (c + 1 < vd->count && vd_above(vd, c + 1, best)) best = c + 1;
-        if (best == i) return;
-        vd_swap(vd, i, best);
-        i = best;
-    }
-}
-
-/* Triangle t's entry made to hold its candidate's key (key < 0: none), after a reserve. */
-static void vd_set(vpdsi_voids *vd, uint32_t t, double key)
-{
-    size_t i = vd->pos[t];
-    if (key < 0) {
-        if (vd->pos[t] == VPDSI_DT_NONE) return;
-        vd->pos[t] = VPDSI_DT_NONE;
-        if (i == --vd->count) return;
-        vd->key[i] = vd->key[vd->count];
-        vd->tri[i] = vd->tri[vd->count];
-        vd->pos[vd->tri[i]] = (uint32_t)i;
-    } else {
-        if (vd->pos[t] == VPDSI_DT_NONE) i = vd->count++;
-        vd->key[i] = key;
-        vd->tri[i] = t;
-        vd->pos[t] = (uint32_t)i;
-    }
-    vd_sift(vd, i);
-}
-
 static void vd_update(vpdsi_voids *vd, const double *pts, uint32_t t)
 {
     double y[2];
-    vd_set(vd, t, vd_candidate(vd, pts, t, y));
+    vpdsi_index_heap_set(&vd->heap, t, vd_candidate(vd, pts, t, y));
 }
 
 /* Room for the entries of two more triangles. */
 static int vd_reserve(vpdsi_voids *vd, vpdsi_mem *m)
 {
-    size_t need = vd->dt.n_tri + 2;
-    return vpdsi_mem_reserve(m, (void **)&vd->key, &vd->cap_key, need, sizeof(double)) ||
-           vpdsi_mem_reserve(m, (void **)&vd->tri, &vd->cap_tri, need, sizeof(uint32_t)) ||
-           vpdsi_mem_reserve(m, (void **)&vd->pos, &vd->cap_pos, need, sizeof(uint32_t));
+    return vpdsi_index_heap_reserve(&vd->heap, m, vd->dt.n_tri + 2);
 }
 
 static int vd_start(vpdsi_voids *vd, vpdsi_mem *m, const double *lo, const double *hi)
@@ -194,7 +133,6 @@ static int vd_start(vpdsi_voids *vd, vpdsi_mem *m, const double *lo, const doubl
         vpdsi_voids_release(vd, m);
         return -1;
     }
-    vd->pos[0] = VPDSI_DT_NONE;
     for (k = 0; k < 4; k++) vd->corner_d2[k] = INFINITY;
     vd->hint = VPDSI_DT_NONE;
     vd->ready = 1;
@@ -206,13 +144,12 @@ static int vd_insert(vpdsi_voids *vd, vpdsi_mem *m, const double *pts, size_t i)
 {
     const vpdsi_dt *dt = &vd->dt;
     const double *p = pts + 2 * i;
-    size_t before = dt->n_tri, j;
+    size_t j;
     int e, k;
     if (vd_reserve(vd, m)) return -1;
     e = vpdsi_dt_insert(&vd->dt, m, pts, i, vd->hint);
     if (e < 0) return e;
     if (e == 0) {
-        for (j = before; j < dt->n_tri; j++) vd->pos[j] = VPDSI_DT_NONE;
         for (j = 0; j < dt->n_rim; j++) {
             uint32_t u = dt->rim[3 * j + 2];
             vd_update(vd, pts, dt->fresh[j]);
@@ -302,9 +239,9 @@ double vpdsi_voids_farthest(vpdsi_voids *vd, const double *pts, double *y)
 {
     double best = -1;
     int k;
-    if (vd->count) {
-        vd->hint = vd->tri[0];
-        best = vd_candidate(vd, pts, vd->tri[0], y);
+    if (vd->heap.count) {
+        vd->hint = vd->heap.id[0];
+        best = vd_candidate(vd, pts, vd->heap.id[0], y);
     }
     for (k = 0; k < 4; k++)
         if (vd->corner_d2[k] > best) {

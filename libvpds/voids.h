@@ -7,16 +7,14 @@
 #ifndef VPDS_VOIDS_H
 #define VPDS_VOIDS_H
 #include "delaunay.h"
+#include "index_heap.h"
 
 typedef struct vpdsi_voids {
     int ready;                /* the triangulation is made */
     vpdsi_dt dt;
     size_t n;                 /* samples in it: the store's [0, n) */
     double corner_d2[4];      /* each corner's squared distance to its nearest sample */
-    double *key; size_t cap_key;   /* the heap: squared gap of triangle tri[i]'s candidate */
-    uint32_t *tri; size_t cap_tri;
-    size_t count;
-    uint32_t *pos; size_t cap_pos; /* each triangle's place in the heap, or VPDSI_DT_NONE */
+    vpdsi_index_heap heap;    /* the triangles by the squared gap of their candidate */
     uint32_t hint;            /* the triangle of the last farthest point: the next walk's start */
     /* samples that came in a batch (a run's, fixed points), inserted in Morton order so that
      * each walk is short: (key << 32 | index), the next at batch[at] */

@@ -253,6 +253,128 @@ static void check_allocation_failures(void)
     printf("stream after a run, allocation failures: %zu allocations, %zu failed once each\n", total, failures);
 }
 
+/* 3D (version 11): each event's t * r is the distance from its point to the samples before it
+ * (brute force), t never rises, at checkpoints it equals version 10's largest gap (the regions'
+ * exact search) of the points before it, and at the end no probe of a grid is farther. */
+static double nearest3(const double *p, size_t n, const double *y)
+{
+    double best = INFINITY;
+    size_t i;
+    for (i = 0; i < n; i++) {
+        double d2 = (p[3 * i] - y[0]) * (p[3 * i] - y[0]) + (p[3 * i + 1] - y[1]) * (p[3 * i + 1] - y[1]) +
+                    (p[3 * i + 2] - y[2]) * (p[3 * i + 2] - y[2]);
+        if (d2 < best) best = d2;
+    }
+    return sqrt(best);
+}
+
+static double gap3_v10(const double *p, size_t n, const double *lo, const double *hi, double r)
+{
+    vpds_desc desc = vpds_default_desc();
+    vpds_sampler *s = NULL;
+    double x[3], t = -1;
+    desc.dim = 3;
+    desc.lo = lo;
+    desc.hi = hi;
+    desc.radius = r;
+    desc.algorithm_version = 10;
+    CHECK(vpds_create(&desc, &s) == VPDS_OK);
+    if (!s) return -1;
+    CHECK(vpds_add_points(s, p, NULL, n) == VPDS_OK);
+    CHECK(vpds_next(s, 0, x, &t) == VPDS_OK);
+    vpds_destroy(s);
+    return t * r;
+}
+
+static void check_stream3(vpds_sampler *s, size_t n, const double *lo, const double *hi, double r, int one_radius,
+                          int grid, const char *what)
+{
+    size_t i, start = vpds_count(s);
+    double prev = INFINITY, t = INFINITY, worst = 0;
+    long c, cells;
+    for (i = 0; i < n; i++) {
+        double x[3];
+        size_t k = vpds_count(s);
+        vpds_status e = vpds_next(s, 0, x, &t);
+        CHECK_MSG(e == VPDS_OK, "%s: event %zu: %s", what, i, vpds_last_error(s));
+        if (e != VPDS_OK) return;
+        CHECK(t <= prev);
+        prev = t;
+        if (k > 0 && one_radius)
+            CHECK_MSG(fabs(nearest3(vpds_points(s), k, x) / (t * r) - 1) < 1e-10, "%s: event %zu at %.17g, t r %.17g",
+                      what, i, nearest3(vpds_points(s), k, x), t * r);
+        if (k > 0 && (i < 12 || i % (n / 5) == 0 || i + 1 == n)) {
+            double oracle = gap3_v10(vpds_points(s), k, lo, hi, r);
+            CHECK_MSG(fabs(oracle / (t * r) - 1) < 1e-9, "%s: event %zu (of %zu samples): t r %.17g, version 10 %.17g",
+                      what, i, k, t * r, oracle);
+        }
+    }
+    for (cells = 1, c = 0; c < 3; c++) cells *= grid + 1;
+    for (c = 0; c < cells; c++) {
+        double q[3], g;
+        long rest = c;
+        int k;
+        for (k = 0; k < 3; k++) {
+            q[k] = lo[k] + (hi[k] - lo[k]) * (double)(rest % (grid + 1)) / grid;
+            rest /= grid + 1;
+        }
+        g = nearest3(vpds_points(s), vpds_count(s) - 1, q);
+        if (g > worst) worst = g;
+    }
+    CHECK_MSG(worst <= t * r * (1 + 1e-9), "%s: a probe %.17g from the set before the last event, t r %.17g", what,
+              worst, t * r);
+    CHECK(vpds_count(s) == start + n);
+}
+
+static vpds_sampler *make3(const double *lo, const double *hi, double r, double inhibition, uint64_t seed)
+{
+    vpds_desc desc = vpds_default_desc();
+    vpds_sampler *s = NULL;
+    desc.dim = 3;
+    desc.lo = lo;
+    desc.hi = hi;
+    desc.radius = r;
+    desc.inhibition = inhibition;
+    desc.seed = seed;
+    CHECK(vpds_create(&desc, &s) == VPDS_OK);
+    return s;
+}
+
+static void check_3d(void)
+{
+    static const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1}, llo[3] = {-1, 0, 0.5}, lhi[3] = {2, 0.5, 1.25};
+    vpds_sampler *s = make3(lo, hi, 0.05, 1, 3);
+    if (s) check_stream3(s, quick ? 300 : 2000, lo, hi, 0.05, 1, quick ? 12 : 24, "3D unit cube");
+    vpds_destroy(s);
+    s = make3(llo, lhi, 0.05, 1, 4);
+    if (s) check_stream3(s, quick ? 300 : 1500, llo, lhi, 0.05, 1, quick ? 12 : 20, "3D long box");
+    vpds_destroy(s);
+    s = make3(lo, hi, 0.05, 0.5, 5);
+    if (s) check_stream3(s, quick ? 200 : 800, lo, hi, 0.05, 0, 12, "3D two radii");
+    vpds_destroy(s);
+    s = make3(lo, hi, 0.08, 1, 6);
+    if (s) {
+        CHECK(vpds_run(s) == VPDS_OK);
+        check_stream3(s, quick ? 50 : 300, lo, hi, 0.08, 1, 16, "3D after a run");
+    }
+    vpds_destroy(s);
+    s = make3(lo, hi, 0.05, 1, 7); /* a lattice of fixed points: cospherical ties, points on faces and edges */
+    if (s) {
+        double f[3 * 125];
+        int a, b, c;
+        for (a = 0; a < 5; a++)
+            for (b = 0; b < 5; b++)
+                for (c = 0; c < 5; c++) {
+                    f[3 * (25 * a + 5 * b + c)] = a / 4.0;
+                    f[3 * (25 * a + 5 * b + c) + 1] = b / 4.0;
+                    f[3 * (25 * a + 5 * b + c) + 2] = c / 4.0;
+                }
+        CHECK(vpds_add_points(s, f, NULL, 125) == VPDS_OK);
+        check_stream3(s, quick ? 200 : 1000, lo, hi, 0.05, 1, 16, "3D after a lattice");
+    }
+    vpds_destroy(s);
+}
+
 static vpds_sampler *make(const double *lo, const double *hi, double r, double inhibition, uint64_t seed)
 {
     vpds_desc desc = vpds_default_desc();
@@ -328,5 +450,6 @@ int main(void)
     }
     vpds_destroy(s);
     check_allocation_failures();
+    check_3d();
     CHECK_DONE();
 }

@@ -168,7 +168,7 @@ def test_exactly_n_points_from_the_stream():
 def test_algorithm_version_pins_the_mesh_stream():
     """Version 7 changed how the stream on a mesh splits its pieces (in two at the longest edge,
     where 3-6 split in four): pinning 6 keeps the older points; runs are the same under both.
-    Versions 8 to 10 changed only boxes: a mesh gives the points of 7."""
+    Versions 8 to 11 changed only boxes: a mesh gives the points of 7."""
     m = trimesh.creation.icosphere(subdivisions=2)
     current = vpds.sample_mesh(m, radius=0.2, n=80, rng=3)
     np.testing.assert_array_equal(vpds.sample_mesh(m, radius=0.2, n=80, rng=3, algorithm_version=7).points,
@@ -184,8 +184,8 @@ def test_algorithm_version_pins_the_mesh_stream():
                                   current.points)
     np.testing.assert_array_equal(vpds.sample_mesh(m, radius=0.2, n=80, rng=3, algorithm_version=9).points,
                                   current.points)
-    for bad in (2, 11, -1, 1.5, True):
-        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 3\.\.10"):
+    for bad in (2, 12, -1, 1.5, True):
+        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 3\.\.11"):
             vpds.sample_mesh(m, algorithm_version=bad)
 
 

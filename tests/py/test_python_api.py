@@ -225,8 +225,9 @@ def test_algorithm_version_pins_the_points():
     search test a splitting box's far corner (the points of 7); version 9 made the stream exact
     in 5D and 6D (2D streams and every run keep the points of 8); version 10 finds the 2D
     stream's farthest point from the Voronoi diagram (the same largest gaps, other bits; every
-    run keeps its points); a version the library does not have is refused."""
-    assert vpds.ALGORITHM_VERSION == 10
+    run keeps its points); version 11 does the same in 3D; a version the library does not have
+    is refused."""
+    assert vpds.ALGORITHM_VERSION == 11
 
     def fill(version, inhibition):
         engine = vpds.PoissonDisk(2, sizing=lambda x: 0.04 + 0.04 * x[:, 0], lipschitz=0.04,
@@ -242,6 +243,7 @@ def test_algorithm_version_pins_the_points():
     assert np.array_equal(current, fill(8, 0.6))
     assert np.array_equal(current, fill(9, 0.6))
     assert np.array_equal(current, fill(10, 0.6))
+    assert np.array_equal(current, fill(11, 0.6))
     assert np.array_equal(current, v3)
     assert np.array_equal(v2, v3)
     assert not np.array_equal(v1, v2)
@@ -253,6 +255,7 @@ def test_algorithm_version_pins_the_points():
 
     # the stream: version 5's farthest points differ from version 4's (to the tolerance)
     assert np.array_equal(stream(None), stream(10))
+    assert np.array_equal(stream(11), stream(10))
     assert not np.array_equal(stream(10), stream(9))
     t10 = [t for _, t in itertools.islice(vpds.PoissonDisk(2, sizing=0.05, seed=3).stream(), 200)]
     t9 = [t for _, t in itertools.islice(vpds.PoissonDisk(2, sizing=0.05, seed=3, algorithm_version=9).stream(), 200)]
@@ -273,7 +276,16 @@ def test_algorithm_version_pins_the_points():
     # 5D: version 9's farthest points are exact, version 8's within the tolerance
     assert np.array_equal(stream5(None), stream5(9))
     assert np.array_equal(stream5(10), stream5(9))
+    assert np.array_equal(stream5(11), stream5(9))
+
+    def stream3(version):
+        engine = vpds.PoissonDisk(3, sizing=0.1, seed=3, algorithm_version=version)
+        return np.array([x for x, _ in itertools.islice(engine.stream(), 100)])
+
+    # 3D: version 11 reads the farthest point from the tetrahedralisation (other bits)
+    assert np.array_equal(stream3(None), stream3(11))
+    assert not np.array_equal(stream3(11), stream3(10))
     assert not np.array_equal(stream5(9), stream5(8))
-    for bad in (11, -1, 1.5, True):
-        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.10"):
+    for bad in (12, -1, 1.5, True):
+        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.11"):
             vpds.PoissonDisk(2, algorithm_version=bad)
