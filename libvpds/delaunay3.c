@@ -97,6 +97,8 @@ void vpdsi_dt3_release(vpdsi_dt3 *dt, vpdsi_mem *m)
     vpdsi_mem_free(m, dt->cavity, dt->cap_cavity * sizeof(uint32_t));
     vpdsi_mem_free(m, dt->rim, dt->cap_rim * sizeof(uint32_t));
     vpdsi_mem_free(m, dt->fresh, dt->cap_fresh * sizeof(uint32_t));
+    vpdsi_mem_free(m, dt->edge_key, dt->cap_edge * sizeof(uint64_t));
+    vpdsi_mem_free(m, dt->edge_face, dt->cap_edge * sizeof(uint32_t));
     memset(dt, 0, sizeof *dt);
 }
 
@@ -245,15 +247,60 @@ static int dt3_repair(vpdsi_dt3 *dt, vpdsi_mem *m, const double *pts, const doub
     return 0;
 }
 
-/* The rim face holding the directed edge (x, y), or -1. */
+/* The rim's directed edges (x, y) -> the face that runs them, by open addressing (a cavity
+ * has a few dozen faces; a scan per look-up cost a fifth of an insert). */
+static size_t dt3_slot(const vpdsi_dt3 *dt, uint64_t key)
+{
+    size_t h = (size_t)((key * 0x9E3779B97F4A7C15ull) >> 32) & (dt->cap_edge - 1);
+    while (dt->edge_key[h] != UINT64_MAX && dt->edge_key[h] != key) h = (h + 1) & (dt->cap_edge - 1);
+    return h;
+}
+
 static long dt3_rim_edge(const vpdsi_dt3 *dt, uint32_t x, uint32_t y)
 {
-    size_t j;
-    int e;
-    for (j = 0; j < dt->n_rim; j++)
-        for (e = 0; e < 3; e++)
-            if (dt->rim[4 * j + (size_t)e] == x && dt->rim[4 * j + (size_t)(e + 1) % 3] == y) return (long)j;
-    return -1;
+    size_t h = dt3_slot(dt, (uint64_t)x << 32 | y);
+    return dt->edge_key[h] == UINT64_MAX ? -1 : (long)dt->edge_face[h];
+}
+
+/* The table of the rim's edges made, and its vertices counted (each edge's start, once: the
+ * vertex keys are (v << 32 | v), apart from every edge's); -1 on OOM, -2 when an edge is run
+ * twice the same way. */
+static int dt3_index_rim(vpdsi_dt3 *dt, vpdsi_mem *m, size_t *verts)
+{
+    size_t need = 64, j, cap;
+    while (need < 8 * dt->n_rim) need *= 2;
+    if (need > dt->cap_edge) {
+        uint64_t *k = (uint64_t *)vpdsi_mem_alloc(m, need * sizeof(uint64_t));
+        uint32_t *f = k ? (uint32_t *)vpdsi_mem_alloc(m, need * sizeof(uint32_t)) : NULL;
+        if (!f) {
+            vpdsi_mem_free(m, k, k ? need * sizeof(uint64_t) : 0);
+            return -1;
+        }
+        vpdsi_mem_free(m, dt->edge_key, dt->cap_edge * sizeof(uint64_t));
+        vpdsi_mem_free(m, dt->edge_face, dt->cap_edge * sizeof(uint32_t));
+        dt->edge_key = k;
+        dt->edge_face = f;
+        dt->cap_edge = need;
+    }
+    cap = dt->cap_edge;
+    memset(dt->edge_key, 0xff, cap * sizeof(uint64_t));
+    *verts = 0;
+    for (j = 0; j < dt->n_rim; j++) {
+        int e;
+        for (e = 0; e < 3; e++) {
+            uint32_t x = dt->rim[4 * j + (size_t)e], y = dt->rim[4 * j + (size_t)(e + 1) % 3];
+            size_t h = dt3_slot(dt, (uint64_t)x << 32 | y), hv;
+            if (dt->edge_key[h] != UINT64_MAX) return -2;
+            dt->edge_key[h] = (uint64_t)x << 32 | y;
+            dt->edge_face[h] = (uint32_t)j;
+            hv = dt3_slot(dt, (uint64_t)x << 32 | x);
+            if (dt->edge_key[hv] == UINT64_MAX) {
+                dt->edge_key[hv] = (uint64_t)x << 32 | x;
+                (*verts)++;
+            }
+        }
+    }
+    return 0;
 }
 
 /* The cavity's faces (a, b, c, the tetrahedron outside), each seen by p, into rim; then every
@@ -261,6 +308,7 @@ static long dt3_rim_edge(const vpdsi_dt3 *dt, uint32_t x, uint32_t y)
 static int dt3_collect_rim(vpdsi_dt3 *dt, vpdsi_mem *m, const double *pts, const double *p)
 {
     size_t j, repairs = 0, verts = 0;
+    int e;
 again:
     dt->n_rim = 0;
     for (j = 0; j < dt->n_cavity; j++) {
@@ -274,7 +322,7 @@ again:
             o = dt3_face_side(dt, pts, c, i, p);
             if (o <= 0 || dt3_flat(DT3_P(DT3_TV(c, f[0])), DT3_P(DT3_TV(c, f[1])), DT3_P(DT3_TV(c, f[2])), p, o)) {
                 if (o > 0) o = 0;
-                int e = ++repairs > DT3_REPAIRS ? -2 : dt3_repair(dt, m, pts, p, j, i, o);
+                e = ++repairs > DT3_REPAIRS ? -2 : dt3_repair(dt, m, pts, p, j, i, o);
                 if (e) return e;
                 goto again;
             }
@@ -285,18 +333,11 @@ again:
             dt->n_rim++;
         }
     }
+    if ((e = dt3_index_rim(dt, m, &verts)) != 0) return e;
     for (j = 0; j < dt->n_rim; j++) {
-        int e;
-        for (e = 0; e < 3; e++) {
-            uint32_t x = dt->rim[4 * j + (size_t)e], y = dt->rim[4 * j + (size_t)(e + 1) % 3];
-            size_t q;
-            int first = 1;
-            if (dt3_rim_edge(dt, y, x) < 0) return -2;
-            for (q = 0; q < j && first; q++) /* count each vertex once */
-                first = dt->rim[4 * q] != x && dt->rim[4 * q + 1] != x && dt->rim[4 * q + 2] != x;
-            for (q = 0; q < (size_t)e && first; q++) first = dt->rim[4 * j + q] != x;
-            verts += first;
-        }
+        int q;
+        for (q = 0; q < 3; q++)
+            if (dt3_rim_edge(dt, dt->rim[4 * j + (size_t)(q + 1) % 3], dt->rim[4 * j + (size_t)q]) < 0) return -2;
     }
     return verts == dt->n_rim / 2 + 2 && dt->n_rim % 2 == 0 ? 0 : -2;
 }

@@ -27,6 +27,7 @@ typedef struct vpdsi_dt3 {
      * tetrahedra (one per face) */
     uint32_t *rim; size_t n_rim, cap_rim;
     uint32_t *fresh; size_t cap_fresh;
+    uint64_t *edge_key; uint32_t *edge_face; size_t cap_edge; /* the rim's edges (delaunay3.c) */
     uint32_t last;            /* a live tetrahedron, where a walk starts without a hint */
     uint32_t free_tet;        /* dead slots (a cavity can hold more tetrahedra than its cone):
                                  tv[4t] = VPDSI_DT3_NONE, tn[4t] the next */

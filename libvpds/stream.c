@@ -917,7 +917,8 @@ static vpds_status voids_event(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_
         if (st->r[i] != st->sizing.radius) sync = -2;
     if (!sync)
         sync = d == 2 ? vpdsi_voids_sync(&sm->voids, ctx->mem, ctx->pb->lo, ctx->pb->hi, st->x, st->n)
-                      : vpdsi_voids3_sync(&sm->voids3, ctx->mem, ctx->pb->lo, ctx->pb->hi, st->x, st->n);
+                      : vpdsi_voids3_sync(&sm->voids3, ctx->mem, ctx->pb->lo, ctx->pb->hi, st->x, st->n,
+                                          t_cap * ctx->pb->coverage * st->sizing.radius * (1 + 1e-9));
     *served = sync != -2;
     if (sync == -2) {
         vpdsi_voids_release(&sm->voids, ctx->mem);

@@ -99,6 +99,8 @@ static double v3_face_crossing(const vpdsi_voids3 *vd, const double *pts, const 
         for (side = 0; side < 2; side++) {
             double x[3], g2, s = ((side ? dt->hi[k] : dt->lo[k]) - cc[k]) / n[k];
             int q;
+            /* a valid crossing is as far from a as from its nearest sample: within the bound */
+            if (fabs(a[k] - (side ? dt->hi[k] : dt->lo[k])) > vd->bound) continue;
             for (q = 0; q < 3; q++) x[q] = cc[q] + s * n[q];
             x[k] = side ? dt->hi[k] : dt->lo[k];
             if (!v3_in_box(dt, x)) continue;
@@ -236,7 +238,7 @@ static double v3_edge_h2(const vpdsi_voids3 *vd, int e, const double *p, double 
     h2 = (p[i] - (e & 1 ? vd->dt.hi[i] : vd->dt.lo[i])) * (p[i] - (e & 1 ? vd->dt.hi[i] : vd->dt.lo[i])) +
          (p[j] - (e & 2 ? vd->dt.hi[j] : vd->dt.lo[j])) * (p[j] - (e & 2 ? vd->dt.hi[j] : vd->dt.lo[j]));
     *s = p[k];
-    return h2 < vd->edge[e].top2 ? h2 : -1;
+    return h2 < vd->edge[e].top2 && h2 <= vd->bound * vd->bound ? h2 : -1;
 }
 
 static int v3_edge_reserve(vpdsi_box_edge *b, vpdsi_mem *m)
@@ -275,6 +277,7 @@ static int v3_start(vpdsi_voids3 *vd, vpdsi_mem *m, const double *lo, const doub
         vd->edge[k].best2 = -1;
     }
     vd->hint = VPDSI_DT3_NONE;
+    vd->bound = INFINITY;
     vd->ready = 1;
     return 0;
 }
@@ -354,11 +357,12 @@ static int v3_make_batch(vpdsi_voids3 *vd, vpdsi_mem *m, const double *pts, size
 }
 
 int vpdsi_voids3_sync(vpdsi_voids3 *vd, vpdsi_mem *m, const double *lo, const double *hi,
-                      const double *pts, size_t n)
+                      const double *pts, size_t n, double bound)
 {
     int e;
     if (n > VPDSI_DT3_MAX_POINTS) return -2;
     if (!vd->ready && v3_start(vd, m, lo, hi)) return -1;
+    vd->bound = bound;
     for (;;) {
         while (vd->at < vd->n_batch) {
             if ((e = v3_insert(vd, m, pts, (size_t)(vd->batch[vd->at] & 0xffffffffu))) != 0) return e;

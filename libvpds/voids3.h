@@ -26,14 +26,17 @@ typedef struct vpdsi_voids3 {
     vpdsi_box_edge edge[12];
     vpdsi_index_heap heap;    /* the tetrahedra by the squared gap of their candidate */
     uint32_t hint;
+    double bound;             /* an upper bound of the largest gap: no crossing farther from its
+                                 samples is valid, so none is computed */
     uint64_t *batch; size_t n_batch, at, cap_batch; /* as vpdsi_voids */
 } vpdsi_voids3;
 
 void vpdsi_voids3_init(vpdsi_voids3 *vd);
 void vpdsi_voids3_release(vpdsi_voids3 *vd, vpdsi_mem *m);
-/* As vpdsi_voids_sync, in 3D (pts: 3 per sample). */
+/* As vpdsi_voids_sync, in 3D (pts: 3 per sample); bound: an upper bound of the box's largest
+ * gap now (the scale at which the set is maximal; +inf: none known). */
 int vpdsi_voids3_sync(vpdsi_voids3 *vd, vpdsi_mem *m, const double *lo, const double *hi,
-                      const double *pts, size_t n);
+                      const double *pts, size_t n, double bound);
 /* The farthest point y of the box from the samples and its squared distance to the nearest. */
 double vpdsi_voids3_farthest(vpdsi_voids3 *vd, const double *pts, double *y);
 #endif
