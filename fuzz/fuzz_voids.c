@@ -2,9 +2,10 @@
  * brute force, on the inputs that break triangulations: fixed points on a coarse lattice of the
  * box (cocircular / cospherical and collinear / coplanar ties, points on the sides, edges and
  * corners, duplicates), now and then one outside the box (the regions then take over, exact
- * to VPDS_STREAM_TOLERANCE), in a box of any aspect. Each event's t * r is the distance from its point to the nearest earlier point, t
- * never rises, and at the end no probe
- * of a grid over the box is farther from the points than the last event's t * r. */
+ * to VPDS_STREAM_TOLERANCE), in a box of any aspect, with one radius or two. Each event's
+ * t * r is the distance from its point to the nearest earlier point (two radii: the point is
+ * no nearer than t * inhibition * r), t never rises, and at the end no probe of a grid over the
+ * box is farther from the points than the last event's t * r. */
 #include "fuzz_common.h"
 
 static double nearest(int dim, const double *p, size_t n, const double *y)
@@ -26,7 +27,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     vpds_desc d = vpds_default_desc();
     double lo[3] = {0, 0, 0}, hi[3], fixed[3 * 64], x[3], t = INFINITY, prev = INFINITY, r = 0.05;
     vpds_sampler *s = NULL;
-    int lattice = 1 + take_u8(&b) % 16, n_fixed = take_u8(&b) % 64, events = 1 + take_u8(&b) % 200, i, k;
+    uint8_t grid = take_u8(&b);
+    /* the high bits: two radii (the draw near the farthest point reads the triangulation) */
+    double inhibition = grid & 0x10 ? 0.25 + 0.25 * (grid >> 5 & 3) : 1.0;
+    int lattice = 1 + grid % 16, n_fixed = take_u8(&b) % 64, events = 1 + take_u8(&b) % 200, i, k;
     uint8_t shape = take_u8(&b);
     int dim = 2 + (shape >> 4 & 1), probes = dim == 2 ? 48 : 14;
     double tol = 1e-9; /* exact; to the stream's tolerance once the regions take over */
@@ -38,6 +42,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     d.lo = lo;
     d.hi = hi;
     d.radius = r;
+    d.inhibition = inhibition;
     d.seed = take_u32(&b);
     FUZZ_ASSERT(vpds_create(&d, &s) == VPDS_OK, "create: %s", "refused");
     for (i = 0; i < n_fixed; i++) {
@@ -56,8 +61,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         for (k = 0; k < dim; k++) FUZZ_ASSERT(x[k] >= lo[k] && x[k] <= hi[k], "event %d outside", i);
         if (before > 0) {
             double g = nearest(dim, vpds_points(s), before, x);
-            FUZZ_ASSERT(g <= t * r * (1 + 1e-9) && g >= t * r * (1 - tol), "event %d: its point %.17g from the set, t r %.17g",
-                        i, g, t * r);
+            if (inhibition == 1.0)
+                FUZZ_ASSERT(g <= t * r * (1 + 1e-9) && g >= t * r * (1 - tol),
+                            "event %d: its point %.17g from the set, t r %.17g", i, g, t * r);
+            else /* a point drawn free at t * inhibition * r (exactly: the kd-tree's test) */
+                FUZZ_ASSERT(g >= t * inhibition * r * (1 - (tol > 1e-9 ? tol : 1e-12)),
+                            "event %d: its point %.17g from the set, t R_f %.17g", i, g, t * inhibition * r);
         }
         prev = t;
     }

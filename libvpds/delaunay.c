@@ -115,9 +115,32 @@ static int dt_among(const vpdsi_dt *dt, size_t from, size_t to, uint32_t t)
     return 0;
 }
 
+/* The round-off bound of dt_incircle, generously: its terms' magnitudes times 1e-10. */
+static double dt_incircle_slack(const double *a, const double *b, const double *c, const double *p)
+{
+    double ax = a[0] - p[0], ay = a[1] - p[1], bx = b[0] - p[0], by = b[1] - p[1];
+    double cx = c[0] - p[0], cy = c[1] - p[1];
+    return 1e-10 * ((ax * ax + ay * ay) * (fabs(bx * cy) + fabs(cx * by)) +
+                    (bx * bx + by * by) * (fabs(cx * ay) + fabs(ax * cy)) +
+                    (cx * cx + cy * cy) * (fabs(ax * by) + fabs(bx * ay)));
+}
+
+/* Whether triangle u's circumcircle holds p: strictly (an insert's cavity), or within the
+ * round-off bound (loose: a query that may take a triangle too many, never one too few). */
+static int dt_holds(const vpdsi_dt *dt, const double *pts, uint32_t u, const double *p, int loose)
+{
+    const uint32_t *w = dt->tv + 3 * (size_t)u;
+    const double *a = vpdsi_dt_point(dt, pts, w[0]), *b = vpdsi_dt_point(dt, pts, w[1]);
+    const double *c = vpdsi_dt_point(dt, pts, w[2]);
+    double ic = dt_incircle(a, b, c, p);
+    if (ic > 0 || !loose) return ic > 0;
+    return ic > -dt_incircle_slack(a, b, c, p);
+}
+
 /* The cavity of p from triangle t: every triangle reached through neighbours whose
- * circumcircle holds p. */
-static int dt_grow_cavity(vpdsi_dt *dt, vpdsi_mem *m, const double *pts, const double *p, uint32_t t)
+ * circumcircle holds p (loosely, for a query). */
+static int dt_grow_cavity(vpdsi_dt *dt, vpdsi_mem *m, const double *pts, const double *p, uint32_t t,
+                          int loose)
 {
     size_t j;
     dt->n_cavity = 0;
@@ -127,13 +150,8 @@ static int dt_grow_cavity(vpdsi_dt *dt, vpdsi_mem *m, const double *pts, const d
         int i;
         for (i = 0; i < 3; i++) {
             uint32_t u = dt->tn[3 * (size_t)c + (size_t)i];
-            const uint32_t *w;
             if (u == VPDSI_DT_NONE || dt_among(dt, 0, dt->n_cavity, u)) continue;
-            w = dt->tv + 3 * (size_t)u;
-            if (dt_incircle(vpdsi_dt_point(dt, pts, w[0]), vpdsi_dt_point(dt, pts, w[1]),
-                            vpdsi_dt_point(dt, pts, w[2]), p) > 0 &&
-                dt_push_cavity(dt, m, u))
-                return -1;
+            if (dt_holds(dt, pts, u, p, loose) && dt_push_cavity(dt, m, u)) return -1;
         }
     }
     return 0;
@@ -271,9 +289,25 @@ int vpdsi_dt_insert(vpdsi_dt *dt, vpdsi_mem *m, const double *pts, size_t index,
         const double *w = vpdsi_dt_point(dt, pts, dt->tv[3 * (size_t)t + (size_t)i]);
         if (w[0] == p[0] && w[1] == p[1]) return 1;
     }
-    if ((e = dt_grow_cavity(dt, m, pts, p, t)) != 0) return e;
+    if ((e = dt_grow_cavity(dt, m, pts, p, t, 0)) != 0) return e;
     if ((e = dt_collect_rim(dt, m, pts, p)) != 0) return e;
     if (vpdsi_mem_reserve(m, (void **)&dt->fresh, &dt->cap_fresh, dt->n_rim, sizeof(uint32_t))) return -1;
     dt_fan(dt, v);
     return 0;
+}
+
+int vpdsi_dt_near(vpdsi_dt *dt, vpdsi_mem *m, const double *pts, const double *p, uint32_t hint)
+{
+    uint32_t t = VPDSI_DT_NONE;
+    /* the cavity is connected: grown from the hint when p lies inside its circumcircle by
+     * more than round-off, else from the triangle that holds p */
+    if (hint < dt->n_tri) {
+        const uint32_t *w = dt->tv + 3 * (size_t)hint;
+        const double *a = vpdsi_dt_point(dt, pts, w[0]), *b = vpdsi_dt_point(dt, pts, w[1]);
+        const double *c = vpdsi_dt_point(dt, pts, w[2]);
+        if (dt_incircle(a, b, c, p) > dt_incircle_slack(a, b, c, p)) t = hint;
+    }
+    if (t == VPDSI_DT_NONE) t = dt_locate(dt, pts, p, hint);
+    if (t == VPDSI_DT_NONE) return -2;
+    return dt_grow_cavity(dt, m, pts, p, t, 1);
 }

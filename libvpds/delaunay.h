@@ -34,6 +34,11 @@ void vpdsi_dt_release(vpdsi_dt *dt, vpdsi_mem *m);
  * is already a vertex (nothing changed), -1 on OOM and -2 when round-off left a cavity that is
  * not a disk around the point: both with nothing changed. */
 int vpdsi_dt_insert(vpdsi_dt *dt, vpdsi_mem *m, const double *pts, size_t index, uint32_t hint);
+/* The triangles whose circumcircle holds p (into cavity[0, n_cavity)), grown from `hint` or
+ * from the triangle that holds p, with a margin for round-off: the cavity p would have, so
+ * that p's nearest point is among their vertices (the edge from p to it is Delaunay), with
+ * perhaps a triangle more. Returns 0, -1 on OOM, -2 when p lies outside the far triangle. */
+int vpdsi_dt_near(vpdsi_dt *dt, vpdsi_mem *m, const double *pts, const double *p, uint32_t hint);
 /* A vertex's coordinates. */
 static inline const double *vpdsi_dt_point(const vpdsi_dt *dt, const double *pts, uint32_t v)
 {

@@ -704,17 +704,50 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
 /* ---- the sample of an event ---- */
 
 
+/* Whether dart x (radius rx) conflicts at scale t * inhibition: 1 or 0, or an error. With the
+ * 2D triangulation (one radius: every sample's f is the same), it conflicts exactly when its
+ * nearest sample does, found among x's Delaunay neighbours and compared as the kd-tree compares
+ * (proximity.h): the same answer. Else the kd-tree, synced here (the triangulation may have
+ * indexed the samples alone). */
+static vpds_status dart_conflicts(const vpdsi_ctx *ctx, vpdsi_voids *vd, double t, const double *x,
+                                  double rx, int *hit)
+{
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_store *st = ctx->st;
+    vpdsi_kd_samples v = vpdsi_store_view(st);
+    double lipschitz = st->sizing.kind == VPDSI_SIZING_CONSTANT ? -1.0 : st->sizing.lipschitz, d2;
+    int32_t found, w = -1;
+    int near = vd ? vpdsi_voids_nearest2(vd, ctx->mem, st->x, x, &d2) : -2;
+    vpds_status e;
+    if (near == -1) {
+        vpdsi_store_error(st, "out of memory for the stream's triangulation");
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    if (near == 0) {
+        double f = t * pb->inhibition * vpdsi_rule_f(pb->rule, st->sizing.radius, rx);
+        *hit = d2 < f * f;
+        return VPDS_OK;
+    }
+    if ((e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
+    found = vpdsi_kd_conflict(&st->tree, &v, x, rx, (int)pb->rule, t * pb->inhibition, lipschitz, &w);
+    if (found == -2) {
+        vpdsi_store_error(st, "sizing breaks lipschitz = %g near sample %d", st->sizing.lipschitz, (int)w);
+        return VPDS_ERR_LIPSCHITZ;
+    }
+    *hit = found != -1;
+    return VPDS_OK;
+}
+
 /* Two radii: a point drawn uniformly from those free at t * inhibition whose coverage disk
  * at t holds y (rejection from the cube around y); y itself if the draws keep failing. */
-static vpds_status draw_near(const vpdsi_ctx *ctx, double t, const double *y, double ry, double *x,
-                             double *rx)
+static vpds_status draw_near(const vpdsi_ctx *ctx, vpdsi_voids *vd, double t, const double *y, double ry,
+                             double *x, double *rx)
 {
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_store *st = ctx->st;
     int d = pb->dim, k;
     int uses_x = vpdsi_rule_may_exceed_ry(pb->rule);
     double sl = t * pb->coverage * st->sizing.lipschitz, rho, diag2 = 0;
-    vpdsi_kd_samples v;
     long tries, max_tries = 64L << d;
     vpds_status e;
     for (k = 0; k < d; k++) diag2 += (pb->hi[k] - pb->lo[k]) * (pb->hi[k] - pb->lo[k]);
@@ -723,8 +756,7 @@ static vpds_status draw_near(const vpdsi_ctx *ctx, double t, const double *y, do
     if (rho * rho > diag2) rho = sqrt(diag2);
     for (tries = 0; tries < max_tries; tries++) {
         double d2 = 0, f;
-        int32_t w, hit;
-        int outside = 0;
+        int outside = 0, hit;
         for (k = 0; k < d; k++) {
             double u = y[k] + (2 * vpdsi_rng_unit(ctx->rng) - 1) * rho;
             d2 += (u - y[k]) * (u - y[k]);
@@ -741,14 +773,8 @@ static vpds_status draw_near(const vpdsi_ctx *ctx, double t, const double *y, do
         if ((e = vpdsi_store_radius_at(st, x, rx)) != VPDS_OK) return e;
         f = t * pb->coverage * vpdsi_rule_f(pb->rule, *rx, ry);
         if (d2 > f * f) continue; /* does not cover y */
-        v = vpdsi_store_view(st);
-        hit = vpdsi_kd_conflict(&st->tree, &v, x, *rx, (int)pb->rule, t * pb->inhibition,
-                                st->sizing.kind == VPDSI_SIZING_CONSTANT ? -1.0 : st->sizing.lipschitz, &w);
-        if (hit == -2) {
-            vpdsi_store_error(st, "sizing breaks lipschitz = %g near sample %d", st->sizing.lipschitz, (int)w);
-            return VPDS_ERR_LIPSCHITZ;
-        }
-        if (hit == -1) return VPDS_OK;
+        if ((e = dart_conflicts(ctx, vd, t, x, *rx, &hit)) != VPDS_OK) return e;
+        if (!hit) return VPDS_OK;
     }
     memcpy(x, y, (size_t)d * sizeof(double));
     *rx = ry;
@@ -878,15 +904,15 @@ static vpds_status bound_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, double k
 
 /* The sample of an event at t that covers y: y itself with one radius, else a point drawn
  * near it (draw_near). */
-static vpds_status event_sample(const vpdsi_ctx *ctx, double t, const double *y, double *x,
-                                double *rx)
+static vpds_status event_sample(const vpdsi_ctx *ctx, vpdsi_voids *vd, double t, const double *y,
+                                double *x, double *rx)
 {
     double ry;
     vpds_status e = vpdsi_store_radius_at(ctx->st, y, &ry);
     if (e != VPDS_OK) return e;
     memcpy(x, y, (size_t)ctx->pb->dim * sizeof(double));
     *rx = ry;
-    return ctx->pb->two_radii ? draw_near(ctx, t, y, ry, x, rx) : VPDS_OK;
+    return ctx->pb->two_radii ? draw_near(ctx, vd, t, y, ry, x, rx) : VPDS_OK;
 }
 
 /* Version 10 finds the farthest point from the Voronoi diagram of the samples (voids.c) with
@@ -935,9 +961,9 @@ static vpds_status voids_event(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_
     t = sqrt(g2) / (ctx->pb->coverage * ry);
     if (t > t_cap) t = t_cap;
     if (t <= t_min) return VPDS_STREAM_END;
-    /* the draw near y reads the kd-tree (the triangulation indexes the samples otherwise) */
-    if (ctx->pb->two_radii && (e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
-    if ((e = event_sample(ctx, t, y, x, &rx)) != VPDS_OK) {
+    /* the draw near y reads the 2D triangulation, in 3D the kd-tree */
+    if (ctx->pb->two_radii && d == 3 && (e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
+    if ((e = event_sample(ctx, d == 2 ? &sm->voids : NULL, t, y, x, &rx)) != VPDS_OK) {
         *ctx->rng = start;
         return e;
     }
@@ -1007,7 +1033,7 @@ vpds_status vpdsi_stream_next(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_m
         event = bound >= next;
         if (event) {
             t = bound > t_cap ? t_cap : bound;
-            if (t > t_min && (e = event_sample(ctx, t, y, x, &rx)) != VPDS_OK) {
+            if (t > t_min && (e = event_sample(ctx, NULL, t, y, x, &rx)) != VPDS_OK) {
                 *ctx->rng = start;
                 return e;
             }

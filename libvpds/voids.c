@@ -251,3 +251,26 @@ double vpdsi_voids_farthest(vpdsi_voids *vd, const double *pts, double *y)
         }
     return best;
 }
+
+int vpdsi_voids_nearest2(vpdsi_voids *vd, vpdsi_mem *m, const double *pts, const double *x, double *d2)
+{
+    const vpdsi_dt *dt = &vd->dt;
+    double best = INFINITY;
+    size_t j;
+    int i, e;
+    if ((e = vpdsi_dt_near(&vd->dt, m, pts, x, vd->hint)) != 0) return e;
+    for (j = 0; j < dt->n_cavity; j++)
+        for (i = 0; i < 3; i++) {
+            uint32_t v = dt->tv[3 * (size_t)dt->cavity[j] + (size_t)i];
+            /* summed as the kd-tree's test sums it (torus.h, open axes): the same bits */
+            if (v >= VPDSI_DT_FAR) {
+                const double *q = pts + 2 * (size_t)(v - VPDSI_DT_FAR);
+                double e0 = fabs(x[0] - q[0]), e1 = fabs(x[1] - q[1]), s = 0;
+                s += e0 * e0;
+                s += e1 * e1;
+                if (s < best) best = s;
+            }
+        }
+    *d2 = best;
+    return 0;
+}

@@ -29,6 +29,11 @@ void vpdsi_voids_release(vpdsi_voids *vd, vpdsi_mem *m);
  * the box or round-off broke a cavity: the triangulation then no longer serves. */
 int vpdsi_voids_sync(vpdsi_voids *vd, vpdsi_mem *m, const double *lo, const double *hi,
                      const double *pts, size_t n);
+/* The squared distance from x (in the box, after a sync) to its nearest sample, found among
+ * the vertices of the triangles whose circumcircle holds x (the edge from x to its nearest
+ * sample is Delaunay); the walk starts at the last farthest point's triangle. Returns 0, -1 on
+ * OOM, -2 when x lies outside the far triangle (never, for x in the box). */
+int vpdsi_voids_nearest2(vpdsi_voids *vd, vpdsi_mem *m, const double *pts, const double *x, double *d2);
 /* The farthest point y of the box from the samples (after a sync with at least one sample)
  * and its squared distance to the nearest one. */
 double vpdsi_voids_farthest(vpdsi_voids *vd, const double *pts, double *y);

@@ -190,12 +190,20 @@ static void check_stream_oracle(vpds_sampler *s, size_t n, const double *lo, con
                                 int one_radius, const char *what)
 {
     size_t i, start = vpds_count(s);
+    double inhibition = one_radius ? 1.0 : 0.5; /* the two radii of these tests: R_f = 0.5 R_c */
     for (i = 0; i < n; i++) {
         double x[2], t;
         size_t k = vpds_count(s);
         vpds_status e = vpds_next(s, 0, x, &t);
         CHECK_MSG(e == VPDS_OK, "%s: event %zu: %s", what, i, vpds_last_error(s));
         if (e != VPDS_OK) return;
+        /* every sample keeps off those before it, by brute force: a draw near the farthest
+         * point (two radii, tested against the triangulation's neighbours) exactly, the
+         * regions' farthest point (after a point outside the box) within their tolerance */
+        if (k > 0)
+            CHECK_MSG(nearest(vpds_points(s), k, x) >= t * inhibition * r * (1 - (one_radius ? VPDS_STREAM_TOLERANCE : 1e-12)),
+                      "%s: event %zu at %.17g from the set, t R_f %.17g", what, i, nearest(vpds_points(s), k, x),
+                      t * inhibition * r);
         if (k > 0 && (i < 12 || i % (n / 6) == 0 || i + 1 == n)) {
             double oracle = gap_v9(vpds_points(s), k, lo, hi, r);
             if (one_radius) /* the sample is the farthest point */
@@ -211,7 +219,7 @@ static void check_stream_oracle(vpds_sampler *s, size_t n, const double *lo, con
 /* After a run, each allocation of the stream (the run's samples go into the triangulation in
  * one batch, in Morton order) fails once in turn: the retry goes on, and the events are those
  * of a stream without failures. */
-static void check_allocation_failures(void)
+static void check_allocation_failures(double inhibition)
 {
     enum { N = 40 };
     vpds_desc d = vpds_default_desc();
@@ -220,6 +228,7 @@ static void check_allocation_failures(void)
     vpds_sampler *s = NULL;
     size_t k, i, base, total, failures = 0;
     d.radius = 0.02;
+    d.inhibition = inhibition;
     d.seed = 11;
     d.allocator.alloc = fa_alloc;
     d.allocator.free = fa_free;
@@ -250,7 +259,8 @@ static void check_allocation_failures(void)
         CHECK_MSG(fa.live == 0, "leak after failing allocation %zu", k);
     }
     CHECK(failures > 0);
-    printf("stream after a run, allocation failures: %zu allocations, %zu failed once each\n", total, failures);
+    printf("stream after a run, inhibition %g, allocation failures: %zu allocations, %zu failed once each\n",
+           inhibition, total, failures);
 }
 
 /* 3D (version 11): each event's t * r is the distance from its point to the samples before it
@@ -449,7 +459,22 @@ int main(void)
         CHECK_MSG(bad == 0, "after a stream and a refinement: %zu pairs closer than tau r", bad);
     }
     vpds_destroy(s);
-    check_allocation_failures();
+    /* two radii after a lattice of fixed points: draws near circles through four samples */
+    s = make(unit_lo, unit_hi, 0.05, 0.5, 9);
+    if (s) {
+        double lattice[2 * 121];
+        int a, b;
+        for (a = 0; a <= 10; a++)
+            for (b = 0; b <= 10; b++) {
+                lattice[2 * (11 * a + b)] = a / 10.0;
+                lattice[2 * (11 * a + b) + 1] = b / 10.0;
+            }
+        CHECK(vpds_add_points(s, lattice, NULL, 121) == VPDS_OK);
+        check_stream_oracle(s, quick ? 200 : 1000, unit_lo, unit_hi, 0.05, 0, "two radii after a lattice");
+    }
+    vpds_destroy(s);
+    check_allocation_failures(1.0);
+    check_allocation_failures(0.5);
     check_3d();
     CHECK_DONE();
 }
