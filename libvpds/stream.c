@@ -716,15 +716,15 @@ static vpds_status dart_conflicts(const vpdsi_ctx *ctx, vpdsi_voids *vd, double 
     vpdsi_store *st = ctx->st;
     vpdsi_kd_samples v = vpdsi_store_view(st);
     double lipschitz = st->sizing.kind == VPDSI_SIZING_CONSTANT ? -1.0 : st->sizing.lipschitz, d2;
+    double f = t * pb->inhibition * vpdsi_rule_f(pb->rule, st->sizing.radius, rx);
     int32_t found, w = -1;
-    int near = vd ? vpdsi_voids_nearest2(vd, ctx->mem, st->x, x, &d2) : -2;
+    int near = vd ? vpdsi_voids_nearest2(vd, ctx->mem, st->x, x, f * f, &d2) : -2;
     vpds_status e;
     if (near == -1) {
         vpdsi_store_error(st, "out of memory for the stream's triangulation");
         return VPDS_ERR_OUT_OF_MEMORY;
     }
     if (near == 0) {
-        double f = t * pb->inhibition * vpdsi_rule_f(pb->rule, st->sizing.radius, rx);
         *hit = d2 < f * f;
         return VPDS_OK;
     }
@@ -935,6 +935,8 @@ static vpds_status voids_event(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_
     vpdsi_store *st = ctx->st;
     vpdsi_rng start = *ctx->rng;
     double y[3], x[3], g2, ry, rx, t;
+    /* no gap exceeds the last event's (t_cap): the triangulation computes no crossing past it */
+    double bound = t_cap * ctx->pb->coverage * st->sizing.radius * (1 + 1e-9);
     vpds_status e;
     size_t i;
     int sync = 0, d = ctx->pb->dim;
@@ -942,9 +944,8 @@ static vpds_status voids_event(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_
     for (i = d == 2 ? sm->voids.n : sm->voids3.n; i < st->n && !sync; i++)
         if (st->r[i] != st->sizing.radius) sync = -2;
     if (!sync)
-        sync = d == 2 ? vpdsi_voids_sync(&sm->voids, ctx->mem, ctx->pb->lo, ctx->pb->hi, st->x, st->n)
-                      : vpdsi_voids3_sync(&sm->voids3, ctx->mem, ctx->pb->lo, ctx->pb->hi, st->x, st->n,
-                                          t_cap * ctx->pb->coverage * st->sizing.radius * (1 + 1e-9));
+        sync = d == 2 ? vpdsi_voids_sync(&sm->voids, ctx->mem, ctx->pb->lo, ctx->pb->hi, st->x, st->n, bound)
+                      : vpdsi_voids3_sync(&sm->voids3, ctx->mem, ctx->pb->lo, ctx->pb->hi, st->x, st->n, bound);
     *served = sync != -2;
     if (sync == -2) {
         vpdsi_voids_release(&sm->voids, ctx->mem);

@@ -43,9 +43,10 @@ static int vd_circumcentre(const double *a, const double *b, const double *c, do
  * their Voronoi edge: no nearer to o1 (opposite in this triangle) or o2 (across the edge)
  * than to them, which on the bisector is exactly the segment between the two circumcentres.
  * Its squared gap, or -1. */
-static double vd_edge_crossing(const vpdsi_dt *dt, const double *pts, uint32_t p, uint32_t q,
+static double vd_edge_crossing(const vpdsi_voids *vd, const double *pts, uint32_t p, uint32_t q,
                                uint32_t o1, uint32_t o2, double *y)
 {
+    const vpdsi_dt *dt = &vd->dt;
     const double *a = vpdsi_dt_point(dt, pts, p), *b = vpdsi_dt_point(dt, pts, q);
     double best = -1;
     int k, side;
@@ -55,6 +56,8 @@ static double vd_edge_crossing(const vpdsi_dt *dt, const double *pts, uint32_t p
         if (dj == 0) continue; /* the bisector is parallel to the sides across axis k */
         for (side = 0; side < 2; side++) {
             double x[2], g2, s = side ? dt->hi[k] : dt->lo[k];
+            /* a valid crossing is as far from a as from its nearest sample: within the bound */
+            if (fabs(a[k] - s) > vd->bound) continue;
             x[k] = s;
             x[j] = 0.5 * (a[j] + b[j]) - (s - 0.5 * (a[k] + b[k])) * dk / dj;
             if (!(x[j] >= dt->lo[j] && x[j] <= dt->hi[j])) continue;
@@ -70,6 +73,14 @@ static double vd_edge_crossing(const vpdsi_dt *dt, const double *pts, uint32_t p
         }
     }
     return best;
+}
+
+/* Whether a side of the box lies within `bound` of a (the filter of vd_edge_crossing, before
+ * the triangle across the edge is read). */
+static int vd_near_side(const vpdsi_dt *dt, const double *a, double bound)
+{
+    return a[0] - dt->lo[0] <= bound || dt->hi[0] - a[0] <= bound || a[1] - dt->lo[1] <= bound ||
+           dt->hi[1] - a[1] <= bound;
 }
 
 /* Triangle t's candidate: its circumcentre when inside the box (a Voronoi vertex), and the
@@ -98,12 +109,13 @@ static double vd_candidate(const vpdsi_voids *vd, const double *pts, uint32_t t,
         double g2;
         int w;
         if (p >= q || p < VPDSI_DT_FAR) continue;
+        if (!vd_near_side(dt, vpdsi_dt_point(dt, pts, p), vd->bound)) continue; /* none within it */
         if (u != VPDSI_DT_NONE)
             for (w = 0; w < 3; w++) {
                 uint32_t c = dt->tv[3 * (size_t)u + (size_t)w];
                 if (c != p && c != q) o2 = c;
             }
-        g2 = vd_edge_crossing(dt, pts, p, q, v[i], o2, z);
+        g2 = vd_edge_crossing(vd, pts, p, q, v[i], o2, z);
         if (g2 > best) {
             best = g2;
             y[0] = z[0];
@@ -135,6 +147,7 @@ static int vd_start(vpdsi_voids *vd, vpdsi_mem *m, const double *lo, const doubl
     }
     for (k = 0; k < 4; k++) vd->corner_d2[k] = INFINITY;
     vd->hint = VPDSI_DT_NONE;
+    vd->bound = INFINITY;
     vd->ready = 1;
     return 0;
 }
@@ -150,11 +163,9 @@ static int vd_insert(vpdsi_voids *vd, vpdsi_mem *m, const double *pts, size_t i)
     e = vpdsi_dt_insert(&vd->dt, m, pts, i, vd->hint);
     if (e < 0) return e;
     if (e == 0) {
-        for (j = 0; j < dt->n_rim; j++) {
-            uint32_t u = dt->rim[3 * j + 2];
-            vd_update(vd, pts, dt->fresh[j]);
-            if (u != VPDSI_DT_NONE) vd_update(vd, pts, u);
-        }
+        /* the triangles across the rim keep their keys: each lost part of its Voronoi edge,
+         * so its candidate can only fall, and vpdsi_voids_farthest mends a key that did */
+        for (j = 0; j < dt->n_rim; j++) vd_update(vd, pts, dt->fresh[j]);
     }
     for (k = 0; k < 4; k++) {
         double c[2], d2;
@@ -208,11 +219,12 @@ static int vd_make_batch(vpdsi_voids *vd, vpdsi_mem *m, const double *pts, size_
 }
 
 int vpdsi_voids_sync(vpdsi_voids *vd, vpdsi_mem *m, const double *lo, const double *hi,
-                     const double *pts, size_t n)
+                     const double *pts, size_t n, double bound)
 {
     int e;
     if (n > VPDSI_DT_MAX_POINTS) return -2;
     if (!vd->ready && vd_start(vd, m, lo, hi)) return -1;
+    vd->bound = bound;
     for (;;) {
         while (vd->at < vd->n_batch) { /* a batch first, to its end */
             if ((e = vd_insert(vd, m, pts, (size_t)(vd->batch[vd->at] & 0xffffffffu))) != 0) return e;
@@ -239,10 +251,17 @@ double vpdsi_voids_farthest(vpdsi_voids *vd, const double *pts, double *y)
 {
     double best = -1;
     int k;
-    if (vd->heap.count) {
-        vd->hint = vd->heap.id[0];
-        best = vd_candidate(vd, pts, vd->heap.id[0], y);
+    /* a key may lie above its triangle's candidate (vd_insert): mended at the top until the
+     * top's holds; every other key is at or above its candidate, so the top is the largest
+     * (ties: the lowest index, as with keys kept exact) */
+    while (vd->heap.count) {
+        uint32_t t = vd->heap.id[0];
+        best = vd_candidate(vd, pts, t, y);
+        if (best == vd->heap.key[0]) break;
+        vpdsi_index_heap_set(&vd->heap, t, best);
+        best = -1;
     }
+    if (vd->heap.count) vd->hint = vd->heap.id[0];
     for (k = 0; k < 4; k++)
         if (vd->corner_d2[k] > best) {
             best = vd->corner_d2[k];
@@ -252,24 +271,44 @@ double vpdsi_voids_farthest(vpdsi_voids *vd, const double *pts, double *y)
     return best;
 }
 
-int vpdsi_voids_nearest2(vpdsi_voids *vd, vpdsi_mem *m, const double *pts, const double *x, double *d2)
+/* The squared distance from x to sample vertex v (any other: INFINITY), summed as the
+ * kd-tree's test sums it (torus.h, open axes): the same bits. */
+static double vd_vertex_d2(const double *pts, uint32_t v, const double *x)
+{
+    const double *q;
+    double e0, e1, s = 0;
+    if (v < VPDSI_DT_FAR) return INFINITY;
+    q = pts + 2 * (size_t)(v - VPDSI_DT_FAR);
+    e0 = fabs(x[0] - q[0]);
+    e1 = fabs(x[1] - q[1]);
+    s += e0 * e0;
+    s += e1 * e1;
+    return s;
+}
+
+int vpdsi_voids_nearest2(vpdsi_voids *vd, vpdsi_mem *m, const double *pts, const double *x, double below,
+                         double *d2)
 {
     const vpdsi_dt *dt = &vd->dt;
     double best = INFINITY;
     size_t j;
     int i, e;
+    /* the farthest point's triangle first: a dart that conflicts mostly meets one of its
+     * vertices, which spares the search of its neighbours */
+    if (vd->hint < dt->n_tri)
+        for (i = 0; i < 3; i++) {
+            double s = vd_vertex_d2(pts, dt->tv[3 * (size_t)vd->hint + (size_t)i], x);
+            if (s < best) best = s;
+        }
+    if (best < below) {
+        *d2 = best;
+        return 0;
+    }
     if ((e = vpdsi_dt_near(&vd->dt, m, pts, x, vd->hint)) != 0) return e;
     for (j = 0; j < dt->n_cavity; j++)
         for (i = 0; i < 3; i++) {
-            uint32_t v = dt->tv[3 * (size_t)dt->cavity[j] + (size_t)i];
-            /* summed as the kd-tree's test sums it (torus.h, open axes): the same bits */
-            if (v >= VPDSI_DT_FAR) {
-                const double *q = pts + 2 * (size_t)(v - VPDSI_DT_FAR);
-                double e0 = fabs(x[0] - q[0]), e1 = fabs(x[1] - q[1]), s = 0;
-                s += e0 * e0;
-                s += e1 * e1;
-                if (s < best) best = s;
-            }
+            double s = vd_vertex_d2(pts, dt->tv[3 * (size_t)dt->cavity[j] + (size_t)i], x);
+            if (s < best) best = s;
         }
     *d2 = best;
     return 0;

@@ -301,7 +301,10 @@ static int v3_insert(vpdsi_voids3 *vd, vpdsi_mem *m, const double *pts, size_t i
             uint32_t u = vd->dt.rim[4 * j + 3], t = vd->dt.fresh[j];
             double y[3];
             vpdsi_index_heap_set(&vd->heap, t, v3_candidate(vd, pts, t, y));
-            if (u != VPDSI_DT3_NONE) vpdsi_index_heap_set(&vd->heap, u, v3_candidate(vd, pts, u, y));
+            /* a tetrahedron across the rim that owns the face now (the lower index) is made
+             * again; one that does not keeps its key: it lost a face or part of one, so its
+             * candidate can only fall, and vpdsi_voids3_farthest mends a key that did */
+            if (u != VPDSI_DT3_NONE && u < t) vpdsi_index_heap_set(&vd->heap, u, v3_candidate(vd, pts, u, y));
         }
         for (k = 0; k < 12; k++)
             if (h2[k] >= 0) v3_edge_add(vd, k, (uint32_t)i, s[k], h2[k]);
@@ -389,10 +392,17 @@ double vpdsi_voids3_farthest(vpdsi_voids3 *vd, const double *pts, double *y)
 {
     double best = -1;
     int k;
-    if (vd->heap.count) {
-        vd->hint = vd->heap.id[0];
-        best = v3_candidate(vd, pts, vd->heap.id[0], y);
+    /* a key may lie above its tetrahedron's candidate (v3_insert): mended at the top until
+     * the top's holds; every other key is at or above its candidate, so the top is the
+     * largest (ties: the lowest index, as with keys kept exact) */
+    while (vd->heap.count) {
+        uint32_t t = vd->heap.id[0];
+        best = v3_candidate(vd, pts, t, y);
+        if (best == vd->heap.key[0]) break;
+        vpdsi_index_heap_set(&vd->heap, t, best);
+        best = -1;
     }
+    if (vd->heap.count) vd->hint = vd->heap.id[0];
     for (k = 0; k < 12; k++)
         if (vd->edge[k].best2 > best) {
             best = vd->edge[k].best2;

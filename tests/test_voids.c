@@ -171,7 +171,7 @@ static void check_farthest(size_t n, const double *lo, const double *hi, int rep
             p[2 * i] = lo[0] + unit() * (hi[0] - lo[0]);
             p[2 * i + 1] = lo[1] + unit() * (hi[1] - lo[1]);
         }
-        CHECK(vpdsi_voids_sync(&vd, &m, lo, hi, p, n) == 0);
+        CHECK(vpdsi_voids_sync(&vd, &m, lo, hi, p, n, INFINITY) == 0);
         g = sqrt(vpdsi_voids_farthest(&vd, p, y));
         CHECK(y[0] >= lo[0] && y[0] <= hi[0] && y[1] >= lo[1] && y[1] <= hi[1]);
         CHECK_MSG(fabs(nearest(p, n, y) / g - 1) < 1e-12, "%zu points: gap %.17g at its point, %.17g said",
