@@ -317,6 +317,31 @@ def stream_rows() -> None:
               flush=True)
         print("   beside " + fps_peer(dim, n), flush=True)
         print("   " + python_progressive(dim, n, total), flush=True)
+        print("   " + two_radii_stream(dim, n, total), flush=True)
+    ramp_streams(2e3 if QUICK else 2e4)
+
+
+def stream_seconds(args: list[str]) -> float:
+    """The total time of a `bench stream`-style command (its last line's third field)."""
+    return float(sh([str(OUT / "bench"), *args]).splitlines()[-1].split()[2])
+
+
+def two_radii_stream(dim: int, n: int, one_radius_seconds: float) -> str:
+    """The stream with R_f = 0.5 R_c (what progressive(n) uses) against R_f = R_c, per sample
+    (target 1.5x in 2D)."""
+    sec = stream_seconds(["stream", str(dim), "1", str(n), "1", "0", "0.5"])
+    return (f"two radii R_f = 0.5 R_c: {sec:.2f} s, {sec / one_radius_seconds:.2f}x the time per "
+            f"sample of R_f = R_c")
+
+
+def ramp_streams(n: float) -> None:
+    """The stream with the ramp r = 0.001 + 0.3 x on the unit square under each rule against a
+    constant radius r = 0.001, the same number of calls (target 2x per sample)."""
+    uniform = stream_seconds(["stream", "2", "0.001", f"{n:g}", "1"])
+    for rule in ("smaller", "prior", "bigger", "current"):
+        sec = stream_seconds(["streamramp", rule, f"{n:g}", "1"])
+        print(f"libvpds 2D stream, ramp r = 0.001 + 0.3 x ({rule}), {n:,.0f} calls: {sec:.2f} s, "
+              f"{sec / uniform:.1f}x the time per sample of r = 0.001 ({uniform:.3f} s)", flush=True)
 
 
 if __name__ == "__main__":
