@@ -473,6 +473,17 @@ int main(void)
         check_stream_oracle(s, quick ? 200 : 1000, unit_lo, unit_hi, 0.05, 0, "two radii after a lattice");
     }
     vpds_destroy(s);
+    /* two radii, then a fixed point outside the box: the regions take over and read the
+     * kd-tree, which the draws near the farthest point (against the triangulation) left
+     * behind; every event keeps off the samples before it */
+    s = make(unit_lo, unit_hi, 0.05, 0.5, 10);
+    if (s) {
+        static const double outside[2] = {1.01, 0.3};
+        check_stream_oracle(s, quick ? 100 : 400, unit_lo, unit_hi, 0.05, 0, "two radii before a point outside");
+        CHECK(vpds_add_points(s, outside, NULL, 1) == VPDS_OK);
+        check_stream_oracle(s, quick ? 50 : 200, unit_lo, unit_hi, 0.05, 0, "two radii after a point outside");
+    }
+    vpds_destroy(s);
     check_allocation_failures(1.0);
     check_allocation_failures(0.5);
     check_3d();
