@@ -125,22 +125,25 @@ static double dt_incircle_slack(const double *a, const double *b, const double *
                     (cx * cx + cy * cy) * (fabs(ax * by) + fabs(bx * ay)));
 }
 
-/* Whether triangle u's circumcircle holds p: strictly (an insert's cavity), or within the
- * round-off bound (loose: a query that may take a triangle too many, never one too few). */
-static int dt_holds(const vpdsi_dt *dt, const double *pts, uint32_t u, const double *p, int loose)
+/* How sure dt_holds must be that triangle u's circumcircle holds p: strictly (an insert's
+ * cavity), within the round-off bound (a query that may take a triangle too many, never one
+ * too few), or beyond it (a triangle surely in the cavity). */
+enum { DT_STRICT, DT_LOOSE, DT_SURE };
+
+static int dt_holds(const vpdsi_dt *dt, const double *pts, uint32_t u, const double *p, int how)
 {
     const uint32_t *w = dt->tv + 3 * (size_t)u;
     const double *a = vpdsi_dt_point(dt, pts, w[0]), *b = vpdsi_dt_point(dt, pts, w[1]);
     const double *c = vpdsi_dt_point(dt, pts, w[2]);
     double ic = dt_incircle(a, b, c, p);
-    if (ic > 0 || !loose) return ic > 0;
-    return ic > -dt_incircle_slack(a, b, c, p);
+    if (how == DT_STRICT || (how == DT_LOOSE && ic > 0)) return ic > 0;
+    return how == DT_LOOSE ? ic > -dt_incircle_slack(a, b, c, p) : ic > dt_incircle_slack(a, b, c, p);
 }
 
 /* The cavity of p from triangle t: every triangle reached through neighbours whose
- * circumcircle holds p (loosely, for a query). */
+ * circumcircle holds p (how: DT_STRICT for an insert, DT_LOOSE for a query). */
 static int dt_grow_cavity(vpdsi_dt *dt, vpdsi_mem *m, const double *pts, const double *p, uint32_t t,
-                          int loose)
+                          int how)
 {
     size_t j;
     dt->n_cavity = 0;
@@ -151,7 +154,7 @@ static int dt_grow_cavity(vpdsi_dt *dt, vpdsi_mem *m, const double *pts, const d
         for (i = 0; i < 3; i++) {
             uint32_t u = dt->tn[3 * (size_t)c + (size_t)i];
             if (u == VPDSI_DT_NONE || dt_among(dt, 0, dt->n_cavity, u)) continue;
-            if (dt_holds(dt, pts, u, p, loose) && dt_push_cavity(dt, m, u)) return -1;
+            if (dt_holds(dt, pts, u, p, how) && dt_push_cavity(dt, m, u)) return -1;
         }
     }
     return 0;
@@ -289,7 +292,7 @@ int vpdsi_dt_insert(vpdsi_dt *dt, vpdsi_mem *m, const double *pts, size_t index,
         const double *w = vpdsi_dt_point(dt, pts, dt->tv[3 * (size_t)t + (size_t)i]);
         if (w[0] == p[0] && w[1] == p[1]) return 1;
     }
-    if ((e = dt_grow_cavity(dt, m, pts, p, t, 0)) != 0) return e;
+    if ((e = dt_grow_cavity(dt, m, pts, p, t, DT_STRICT)) != 0) return e;
     if ((e = dt_collect_rim(dt, m, pts, p)) != 0) return e;
     if (vpdsi_mem_reserve(m, (void **)&dt->fresh, &dt->cap_fresh, dt->n_rim, sizeof(uint32_t))) return -1;
     dt_fan(dt, v);
@@ -298,16 +301,9 @@ int vpdsi_dt_insert(vpdsi_dt *dt, vpdsi_mem *m, const double *pts, size_t index,
 
 int vpdsi_dt_near(vpdsi_dt *dt, vpdsi_mem *m, const double *pts, const double *p, uint32_t hint)
 {
-    uint32_t t = VPDSI_DT_NONE;
     /* the cavity is connected: grown from the hint when p lies inside its circumcircle by
      * more than round-off, else from the triangle that holds p */
-    if (hint < dt->n_tri) {
-        const uint32_t *w = dt->tv + 3 * (size_t)hint;
-        const double *a = vpdsi_dt_point(dt, pts, w[0]), *b = vpdsi_dt_point(dt, pts, w[1]);
-        const double *c = vpdsi_dt_point(dt, pts, w[2]);
-        if (dt_incircle(a, b, c, p) > dt_incircle_slack(a, b, c, p)) t = hint;
-    }
-    if (t == VPDSI_DT_NONE) t = dt_locate(dt, pts, p, hint);
+    uint32_t t = hint < dt->n_tri && dt_holds(dt, pts, hint, p, DT_SURE) ? hint : dt_locate(dt, pts, p, hint);
     if (t == VPDSI_DT_NONE) return -2;
-    return dt_grow_cavity(dt, m, pts, p, t, 1);
+    return dt_grow_cavity(dt, m, pts, p, t, DT_LOOSE);
 }

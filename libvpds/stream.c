@@ -714,21 +714,25 @@ static vpds_status dart_conflicts(const vpdsi_ctx *ctx, vpdsi_voids *vd, double 
 {
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_store *st = ctx->st;
-    vpdsi_kd_samples v = vpdsi_store_view(st);
-    double lipschitz = st->sizing.kind == VPDSI_SIZING_CONSTANT ? -1.0 : st->sizing.lipschitz, d2;
-    double f = t * pb->inhibition * vpdsi_rule_f(pb->rule, st->sizing.radius, rx);
+    vpdsi_kd_samples v;
+    double lipschitz;
     int32_t found, w = -1;
-    int near = vd ? vpdsi_voids_nearest2(vd, ctx->mem, st->x, x, f * f, &d2) : -2;
     vpds_status e;
-    if (near == -1) {
-        vpdsi_store_error(st, "out of memory for the stream's triangulation");
-        return VPDS_ERR_OUT_OF_MEMORY;
-    }
-    if (near == 0) {
-        *hit = d2 < f * f;
-        return VPDS_OK;
+    if (vd) {
+        double d2, f = t * pb->inhibition * vpdsi_rule_f(pb->rule, st->sizing.radius, rx);
+        int near = vpdsi_voids_nearest2(vd, ctx->mem, st->x, x, f * f, &d2);
+        if (near == -1) {
+            vpdsi_store_error(st, "out of memory for the stream's triangulation");
+            return VPDS_ERR_OUT_OF_MEMORY;
+        }
+        if (near == 0) {
+            *hit = d2 < f * f;
+            return VPDS_OK;
+        }
     }
     if ((e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
+    v = vpdsi_store_view(st);
+    lipschitz = st->sizing.kind == VPDSI_SIZING_CONSTANT ? -1.0 : st->sizing.lipschitz;
     found = vpdsi_kd_conflict(&st->tree, &v, x, rx, (int)pb->rule, t * pb->inhibition, lipschitz, &w);
     if (found == -2) {
         vpdsi_store_error(st, "sizing breaks lipschitz = %g near sample %d", st->sizing.lipschitz, (int)w);
@@ -962,8 +966,7 @@ static vpds_status voids_event(vpdsi_stream *sm, const vpdsi_ctx *ctx, double t_
     t = sqrt(g2) / (ctx->pb->coverage * ry);
     if (t > t_cap) t = t_cap;
     if (t <= t_min) return VPDS_STREAM_END;
-    /* the draw near y reads the 2D triangulation, in 3D the kd-tree */
-    if (ctx->pb->two_radii && d == 3 && (e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
+    /* the draw near y reads the 2D triangulation, in 3D the kd-tree (synced by the draw) */
     if ((e = event_sample(ctx, d == 2 ? &sm->voids : NULL, t, y, x, &rx)) != VPDS_OK) {
         *ctx->rng = start;
         return e;

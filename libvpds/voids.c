@@ -1,6 +1,7 @@
 /* The stream's farthest point in 2D from the Voronoi diagram (voids.h): one candidate per
  * Delaunay triangle, the triangles in an indexed max-heap (index_heap.h). */
 #include "voids.h"
+#include "torus.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -254,13 +255,8 @@ double vpdsi_voids_farthest(vpdsi_voids *vd, const double *pts, double *y)
     /* a key may lie above its triangle's candidate (vd_insert): mended at the top until the
      * top's holds; every other key is at or above its candidate, so the top is the largest
      * (ties: the lowest index, as with keys kept exact) */
-    while (vd->heap.count) {
-        uint32_t t = vd->heap.id[0];
-        best = vd_candidate(vd, pts, t, y);
-        if (best == vd->heap.key[0]) break;
-        vpdsi_index_heap_set(&vd->heap, t, best);
-        best = -1;
-    }
+    while (vd->heap.count && (best = vd_candidate(vd, pts, vd->heap.id[0], y)) != vd->heap.key[0])
+        vpdsi_index_heap_set(&vd->heap, vd->heap.id[0], best); /* best < 0 takes it out */
     if (vd->heap.count) vd->hint = vd->heap.id[0];
     for (k = 0; k < 4; k++)
         if (vd->corner_d2[k] > best) {
@@ -271,19 +267,13 @@ double vpdsi_voids_farthest(vpdsi_voids *vd, const double *pts, double *y)
     return best;
 }
 
-/* The squared distance from x to sample vertex v (any other: INFINITY), summed as the
- * kd-tree's test sums it (torus.h, open axes): the same bits. */
+/* The squared distance from x to sample vertex v (a far vertex: INFINITY), as the kd-tree's
+ * test measures it (open axes): the same bits. */
 static double vd_vertex_d2(const double *pts, uint32_t v, const double *x)
 {
-    const double *q;
-    double e0, e1, s = 0;
+    static const double open_axes[2] = {0, 0};
     if (v < VPDSI_DT_FAR) return INFINITY;
-    q = pts + 2 * (size_t)(v - VPDSI_DT_FAR);
-    e0 = fabs(x[0] - q[0]);
-    e1 = fabs(x[1] - q[1]);
-    s += e0 * e0;
-    s += e1 * e1;
-    return s;
+    return vpdsi_torus_dist2(x, pts + 2 * (size_t)(v - VPDSI_DT_FAR), 2, open_axes);
 }
 
 int vpdsi_voids_nearest2(vpdsi_voids *vd, vpdsi_mem *m, const double *pts, const double *x, double below,

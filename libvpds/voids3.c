@@ -395,13 +395,8 @@ double vpdsi_voids3_farthest(vpdsi_voids3 *vd, const double *pts, double *y)
     /* a key may lie above its tetrahedron's candidate (v3_insert): mended at the top until
      * the top's holds; every other key is at or above its candidate, so the top is the
      * largest (ties: the lowest index, as with keys kept exact) */
-    while (vd->heap.count) {
-        uint32_t t = vd->heap.id[0];
-        best = v3_candidate(vd, pts, t, y);
-        if (best == vd->heap.key[0]) break;
-        vpdsi_index_heap_set(&vd->heap, t, best);
-        best = -1;
-    }
+    while (vd->heap.count && (best = v3_candidate(vd, pts, vd->heap.id[0], y)) != vd->heap.key[0])
+        vpdsi_index_heap_set(&vd->heap, vd->heap.id[0], best); /* best < 0 takes it out */
     if (vd->heap.count) vd->hint = vd->heap.id[0];
     for (k = 0; k < 12; k++)
         if (vd->edge[k].best2 > best) {
