@@ -4,6 +4,7 @@
  * else splits into 2^d. Boxes live in coordinates around the anchor; on a periodic axis the
  * kd-tree wraps them. The search reads candidate lists handed down from box to sub-box. */
 #include "uncovered.h"
+#include "proximity.h"
 #include "rules.h"
 #include "torus.h"
 #include <math.h>
@@ -12,6 +13,9 @@
 #define UNCOVERED_DEPTH 40
 #define LIST_CAP 128 /* candidates a box keeps for its sub-boxes; more and they read the kd-trees */
 #define LIST_SLOTS ((size_t)(UNCOVERED_DEPTH + 1) * 2 * LIST_CAP)
+#ifndef VPDSI_GRID_LIST_CAP /* tests/determinism.sh builds one tool with a tiny one */
+#define VPDSI_GRID_LIST_CAP LIST_CAP /* a grid's list longer than this: the kd-tree serves */
+#endif
 
 /* Every box of a search used to walk the kd-trees from their roots, several times; a search
  * examines thousands of boxes, most of them deep and small. Instead each box keeps two lists
@@ -34,6 +38,8 @@ typedef struct {
     double centre[VPDS_MAX_DIM];
     double r_anchor, scale, L, reach, slack;
     int point, lists; /* lists: the slots are allocated */
+    int grid;         /* the run's background grid serves the first lists (grid_list) */
+    int tree_synced;  /* the store's kd-tree holds every sample: the tests may read it */
     int exact_region; /* version 2: a box beyond a point anchor's region is dropped */
     int in_cell;      /* the search lies in one indexed cell: the centres cannot prune */
     size_t budget;    /* boxes this search may examine */
@@ -93,34 +99,84 @@ static int near_uncovered(bb_search *q, int depth, const double *c2, double thr)
                                      (int)VPDS_RULE_PRIOR, NULL) > thr);
 }
 
+/* With one radius the run's background grid holds every sample near a box that lies in one of
+ * its cells: its stencil reaches t * inhibition * r, no less than the coverage reach, with a
+ * margin of 1e-6 (bgrid.c), above the lists' 1e-9. The box's list comes from there, and the
+ * kd-tree is not built (its build took a sixth of an annulus run). 0: the list is in slot off;
+ * 1: the box spans cells or the list overflows, the kd-tree must serve. */
+static int grid_list(bb_search *q, const double *lo, const double *hi, double rb, size_t off,
+                     size_t *count)
+{
+    const vpdsi_bgrid *g = &q->st->grid;
+    const double *period = q->pb->period;
+    uint64_t c[VPDS_MAX_DIM];
+    size_t n, j, kept = 0;
+    int k;
+    for (k = 0; k < g->dim; k++) {
+        double u = floor((0.5 * (lo[k] + hi[k]) - g->lo[k]) / g->side[k]), tol = 1e-9 * g->side[k];
+        double clo;
+        c[k] = u <= 0 ? 0 : (uint64_t)u;
+        if (c[k] >= g->n[k]) c[k] = g->n[k] - 1;
+        clo = g->lo[k] + (double)c[k] * g->side[k];
+        if (lo[k] < clo - tol || hi[k] > clo + g->side[k] + tol) return 1;
+    }
+    n = vpdsi_bgrid_near(g, vpdsi_bgrid_index(g, c), q->u->grid_cand);
+    for (j = 0; j < n; j++) {
+        int32_t i = q->u->grid_cand[j];
+        if (!vpdsi_prox_near(&q->view, i, g->dim, period, lo, hi, rb, q->scale, q->slack)) continue;
+        if (kept == VPDSI_GRID_LIST_CAP) return 1;
+        q->u->lists[off + kept++] = i;
+    }
+    *count = kept;
+    return 0;
+}
+
+/* The kd-tree made whole before a test reads it (the grid's lists spared it so far). */
+static vpds_status need_tree(bb_search *q)
+{
+    vpds_status e;
+    if (q->tree_synced) return VPDS_OK;
+    if ((e = vpdsi_store_sync_tree(q->st)) != VPDS_OK) return e;
+    q->tree_synced = 1;
+    return VPDS_OK;
+}
+
 /* This box's samples, from its parent's list while r stays below the parent's bound, else from
- * the tree; r_bound = r_hi + L * diag bounds r_hi of every sub-box when r is L-Lipschitz, and a
- * sub-box that finds otherwise starts again from the tree. */
-static void sample_list(bb_search *q, int depth, const double *lo, const double *hi, double rp,
-                        double r_hi, double diag)
+ * the grid or the tree; r_bound = r_hi + L * diag bounds r_hi of every sub-box when r is
+ * L-Lipschitz, and a sub-box that finds otherwise starts again from the index. */
+static vpds_status sample_list(bb_search *q, int depth, const double *lo, const double *hi,
+                               double rp, double r_hi, double diag)
 {
     bb_lists *me = &q->lv[depth], *up = depth > 0 ? &q->lv[depth - 1] : NULL;
     size_t off = slot(depth, 1);
     double rb = r_hi + q->L * diag;
-    if (!q->lists) return;
-    if (q->st->tree.n_nodes == 0) { /* no sample: the empty list is complete for any r */
-        me->s_n = 0;
-        me->s_ok = 1;
-        me->r_bound = INFINITY;
-        return;
-    }
+    vpds_status e;
+    if (!q->lists) return need_tree(q);
+    me->r_bound = rb;
     if (up && up->s_ok && rp <= up->r_bound && r_hi <= up->r_bound) {
         if (rb > up->r_bound) rb = up->r_bound;
         me->s_n = vpdsi_kd_filter_near(&q->st->tree, &q->view, q->u->lists + slot(depth - 1, 1), up->s_n,
                                        lo, hi, rb, q->scale, q->slack, q->u->lists + off);
         me->s_ok = 1;
+        me->r_bound = rb;
+        return VPDS_OK;
+    }
+    if (q->grid && grid_list(q, lo, hi, rb, off, &me->s_n) == 0) {
+        me->s_ok = 1;
+        return VPDS_OK;
+    }
+    if ((e = need_tree(q)) != VPDS_OK) return e;
+    if (q->st->tree.n_nodes == 0) { /* no sample: the empty list is complete for any r */
+        me->s_n = 0;
+        me->s_ok = 1;
+        me->r_bound = INFINITY;
     } else if ((q->count = off,
                 vpdsi_kd_near_box(&q->st->tree, &q->view, lo, hi, rb, q->scale, q->slack, LIST_CAP,
                                   q->st->mem, &q->u->lists, &q->count, &q->u->cap_lists)) == 0) {
         me->s_n = q->count - off;
         me->s_ok = 1;
     }
-    me->r_bound = rb;
+    return VPDS_OK;
 }
 
 /* A sample that covers p at t * coverage, or -1 (vpdsi_kd_conflict, from the list when
@@ -279,7 +335,7 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
             if (d2 > f_hi * f_hi) return VPDS_OK;
         }
     }
-    sample_list(q, depth, lo, hi, q->rp, r_hi, diag);
+    if ((st = sample_list(q, depth, lo, hi, q->rp, r_hi, diag)) != VPDS_OK) return st;
     q->cover = -1;
     if (in_region && (q->cover = p_cover(q, depth, p, q->rp)) < 0) {
         /* p is uncovered: no sample within t*coverage*f of it; a witness if in the domain */
@@ -467,10 +523,13 @@ static vpds_status prepare(bb_search *q, vpdsi_uncovered *u, const vpdsi_ctx *ct
         vpdsi_store_error(st, "out of memory for the two-radii coverage search");
         return VPDS_ERR_OUT_OF_MEMORY;
     }
-    if ((e = vpdsi_store_sync_tree(st)) != VPDS_OK) return e;
     /* without room for the lists every test reads the kd-trees, as fast as before them */
     q->lists = vpdsi_mem_reserve(st->mem, (void **)&u->lists, &u->cap_lists, LIST_SLOTS,
                                  sizeof(int32_t)) == 0;
+    q->grid = q->lists && st->grid_mode &&
+              vpdsi_mem_reserve(st->mem, (void **)&u->grid_cand, &u->cap_grid_cand,
+                                st->grid.n_stencil + 1, sizeof(int32_t)) == 0;
+    if (!q->grid && (e = need_tree(q)) != VPDS_OK) return e;
     q->view = vpdsi_store_view(st);
     q->uview = vpdsi_uncovered_view(u);
     return VPDS_OK;

@@ -32,6 +32,7 @@ typedef struct vpdsi_uncovered {
     double *nwit; size_t n_nwit, cap_nwit;
     size_t n_centre_of;
     int32_t *cand; size_t cap_cand;    /* the indexed cells near a dart */
+    int32_t *grid_cand; size_t cap_grid_cand; /* a search's first list, from the background grid */
     /* Version 6: per indexed cell, which of its sub-boxes at depth sub_depth of the search's
      * halving a search showed covered (bit i: the i-th, first halving most significant), so that
      * the later questions on the cell (about ten per cell, Figure 2's neighbourhoods overlap)

@@ -30,14 +30,15 @@ void vpdsi_uncovered_release(vpdsi_uncovered *u, vpdsi_mem *m)
     vpdsi_mem_free(m, u->state, u->cap_state);
     vpdsi_mem_free(m, u->centre_of, u->cap_centre_of * sizeof(int32_t));
     vpdsi_mem_free(m, u->cand, u->cap_cand * sizeof(int32_t));
+    vpdsi_mem_free(m, u->grid_cand, u->cap_grid_cand * sizeof(int32_t));
     vpdsi_mem_free(m, u->sub, u->cap_sub * sizeof(uint64_t));
     u->sub = NULL;
     u->cap_sub = 0;
     u->sub_depth = 0;
     u->flag = u->f = u->state = NULL;
     u->x = u->r = u->stack = u->cbox = u->wit = u->nwit = NULL;
-    u->lists = u->centre_of = u->cand = NULL;
-    u->cap_flag = u->cap_x = u->cap_r = u->cap_f = u->cap_lists = u->cap_stack = 0;
+    u->lists = u->centre_of = u->cand = u->grid_cand = NULL;
+    u->cap_flag = u->cap_x = u->cap_r = u->cap_f = u->cap_lists = u->cap_stack = u->cap_grid_cand = 0;
     u->cap_cbox = u->cap_wit = u->cap_nwit = u->cap_state = u->cap_centre_of = u->cap_cand = 0;
     u->n_nwit = u->n_centre_of = 0;
     u->ready = u->learn = 0;
