@@ -164,6 +164,33 @@ size_t vpdsi_bgrid_near(const vpdsi_bgrid *g, uint64_t at, int32_t *out)
     return found;
 }
 
+#ifndef BGRID_PREFETCH_SAMPLES
+#define BGRID_PREFETCH_SAMPLES 2 /* the nearest samples whose points stage 1 asks for */
+#endif
+
+void vpdsi_bgrid_prefetch(const vpdsi_bgrid *g, const double *x, const double *y, int stage)
+{
+    const int32_t *cell = g->cell + vpdsi_bgrid_locate(g, y);
+    int64_t w = (int64_t)g->pad, a;
+    size_t j, asked = 0;
+    if (g->dim != 2) return;
+    if (stage == 0) { /* each row along axis 0, its two ends (it may cross a cache line) */
+        for (a = -w; a <= w; a++) {
+            VPDSI_PREFETCH(cell + a * (int64_t)g->stride[1] - w);
+            VPDSI_PREFETCH(cell + a * (int64_t)g->stride[1] + w);
+        }
+        return;
+    }
+    if (cell[0] >= 0) return; /* the test ends there without a point */
+    for (j = 0; j < g->n_stencil && asked < BGRID_PREFETCH_SAMPLES; j++) {
+        int32_t i = cell[g->stencil[j]];
+        if (i >= 0) {
+            VPDSI_PREFETCH(x + 2 * (size_t)i);
+            asked++;
+        }
+    }
+}
+
 int32_t vpdsi_bgrid_conflict(const vpdsi_bgrid *g, const double *x, const double *y, double reach)
 {
     const int32_t *cell = g->cell + vpdsi_bgrid_locate(g, y);

@@ -117,6 +117,14 @@ void vpdsi_cells_move(vpdsi_cells *c, size_t from, size_t to)
                c->words_per_cell * sizeof *c->words);
 }
 
+void vpdsi_cells_prefetch(const vpdsi_cells *c, size_t i)
+{
+    if (c->words_per_cell == 0)
+        VPDSI_PREFETCH((const unsigned char *)c->words + i * sizeof(uint32_t));
+    else
+        VPDSI_PREFETCH(c->words + i * c->words_per_cell);
+}
+
 void vpdsi_cells_get(const vpdsi_cells *c, size_t i, int dim, uint64_t *coord)
 {
     const uint64_t *w = c->words + i * c->words_per_cell;

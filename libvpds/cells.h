@@ -21,6 +21,8 @@ void vpdsi_cells_release(vpdsi_cells *c, vpdsi_mem *m);
 /* Append (after reserve; never allocates) and read back. */
 void vpdsi_cells_push(vpdsi_cells *c, int dim, const uint64_t *coord);
 void vpdsi_cells_get(const vpdsi_cells *c, size_t i, int dim, uint64_t *coord);
+/* A hint that cell i will be read soon (a dart's cell is drawn at random among them all). */
+void vpdsi_cells_prefetch(const vpdsi_cells *c, size_t i);
 /* Copy cell `from` over cell `to` (in-place compaction, to <= from). */
 void vpdsi_cells_move(vpdsi_cells *c, size_t from, size_t to);
 /* The geometry of the cells: a base grid of n0[k] cells of side side0[k] per axis over the box

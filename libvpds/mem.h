@@ -20,4 +20,10 @@ void vpdsi_mem_free(vpdsi_mem *m, void *p, size_t size);
 int vpdsi_mem_reserve(vpdsi_mem *m, void **p, size_t *cap, size_t need, size_t elem);
 /* a*b without overflow: returns 0 and writes *out, or -1. */
 int vpdsi_mul_size(size_t a, size_t b, size_t *out);
+/* A hint that p will be read soon (GCC, Clang); nothing elsewhere. */
+#if defined(__GNUC__) || defined(__clang__)
+#define VPDSI_PREFETCH(p) __builtin_prefetch(p)
+#else
+#define VPDSI_PREFETCH(p) ((void)(p))
+#endif
 #endif

@@ -208,14 +208,30 @@ static uint64_t cur_count(const vpdsi_mps *m)
 
 /* n darts into out (n*dim): a cell uniformly, then a point uniformly in it; in weighted mode
  * one more uniform per dart into u, for its acceptance (Eq. 12). */
+#ifndef CELL_PREFETCH
+#define CELL_PREFETCH 8 /* darts ahead whose cells are asked for */
+#endif
+/* A copy of the dart generator CELL_PREFETCH darts ahead: the cell it will draw is asked for
+ * (the cells lie anywhere in memory), then its draws are spent as the dart's. */
+static void prefetch_ahead(const vpdsi_mps *m, vpdsi_rng *ahead, uint64_t total, int d, int with_u)
+{
+    uint64_t idx = vpdsi_rng_below(ahead, total);
+    int k;
+    if (!m->run.implicit) vpdsi_cells_prefetch(&m->run.cur, (size_t)idx);
+    for (k = 0; k < d + with_u; k++) (void)vpdsi_rng_unit(ahead);
+}
+
 static void draw_darts(const vpdsi_mps *m, const vpdsi_ctx *ctx, vpdsi_rng *rng, size_t n, double *out, double *u)
 {
     uint64_t c[VPDS_MAX_DIM], total = cur_count(m);
     double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
     unsigned level = cur_level(m);
     size_t j;
-    int k, d = ctx->pb->dim;
+    int k, d = ctx->pb->dim, ahead_on = !m->run.implicit && n > CELL_PREFETCH;
+    vpdsi_rng ahead = *rng;
+    for (j = 0; ahead_on && j < CELL_PREFETCH; j++) prefetch_ahead(m, &ahead, total, d, u != NULL);
     for (j = 0; j < n; j++) {
+        if (ahead_on && j + CELL_PREFETCH < n) prefetch_ahead(m, &ahead, total, d, u != NULL);
         cell_coords(m, ctx, vpdsi_rng_below(rng, total), c);
         vpdsi_lattice_box(&m->run.geom, level, c, lo, hi);
         for (k = 0; k < d; k++) {
@@ -324,6 +340,9 @@ static vpds_status judge_dart(vpdsi_mps *m, const vpdsi_ctx *ctx, const double *
     return VPDS_OK;
 }
 
+#ifndef DART_PREFETCH
+#define DART_PREFETCH 8 /* darts ahead whose cells and samples are asked for (vpdsi_bgrid_prefetch) */
+#endif
 static vpds_status darts_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
 {
     vpdsi_store *st = ctx->st;
@@ -336,6 +355,10 @@ static vpds_status darts_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
     for (j = 0; j < n; j++) {
         const double *y = m->buf_x + j * (size_t)ctx->pb->dim;
         int accept;
+        if (st->grid_mode && j + 2 * DART_PREFETCH < n)
+            vpdsi_bgrid_prefetch(&st->grid, st->x, y + 2 * DART_PREFETCH * (size_t)ctx->pb->dim, 0);
+        if (st->grid_mode && j + DART_PREFETCH < n)
+            vpdsi_bgrid_prefetch(&st->grid, st->x, y + DART_PREFETCH * (size_t)ctx->pb->dim, 1);
         if (weighted && m->buf_u[j] == 0.0) continue;
         if ((e = judge_dart(m, ctx, y, m->buf_r[j], &accept)) != VPDS_OK) {
             /* keep the darts before this one, as a pause would */
