@@ -6,12 +6,16 @@ void vpdsi_bgrid_release(vpdsi_bgrid *g, vpdsi_mem *m)
 {
     vpdsi_mem_free(m, g->cell, g->cap_cell * sizeof *g->cell);
     vpdsi_mem_free(m, g->stencil, g->cap_stencil * sizeof *g->stencil);
+    vpdsi_mem_free(m, g->stencil_tag, g->cap_stencil_tag * sizeof *g->stencil_tag);
+    vpdsi_mem_free(m, g->row, g->cap_row * sizeof *g->row);
+    vpdsi_mem_free(m, g->row_w, g->cap_row_w * sizeof *g->row_w);
     memset(g, 0, sizeof *g);
 }
 
 typedef struct {
     int64_t offset;
     double d2;
+    int o0, w; /* its axis-0 offset, its row's width (row_width) */
 } stencil_entry;
 
 /* The stencil's reach in cells: the border's width (0: too wide for this grid). */
@@ -34,6 +38,65 @@ double vpdsi_bgrid_cells(int dim, const double *n, const double *side, double re
     if (span == 0) return 0;
     for (k = 0; k < dim; k++) total *= n[k] + 2 * span;
     return total;
+}
+
+/* Whether the cell at offsets o lies in the stencil (or is the centre): the test of the
+ * stencil's loop below, in its order of sums. */
+static int in_stencil(int dim, const double *side, double reach, const int *o)
+{
+    double d2 = 0;
+    int k;
+    for (k = 0; k < dim; k++) {
+        int a = o[k] < 0 ? -o[k] : o[k];
+        double gap = a > 1 ? (a - 1) * side[k] : 0;
+        d2 += gap * gap;
+    }
+    return d2 < reach * reach * (1 + 1e-6);
+}
+
+/* The largest axis-0 offset of a stencil cell in the row through o (o[0] ignored); -1: none.
+ * The row holds exactly the offsets -w..w: the gap only grows with |o0|. */
+static int row_width(int dim, const double *side, double reach, uint64_t span, const int *o)
+{
+    int t[VPDS_MAX_DIM], w = -1, a;
+    memcpy(t, o, (size_t)dim * sizeof *t);
+    for (a = 0; a <= (int)span; a++) {
+        t[0] = a;
+        if (!in_stencil(dim, side, reach, t)) break;
+        w = a;
+    }
+    return w;
+}
+
+/* The rows of the stencil (vpdsi_bgrid_slide) and the centre's tag. */
+static int setup_rows(vpdsi_bgrid *g, vpdsi_mem *m, const double *side, double reach)
+{
+    int o[VPDS_MAX_DIM], k, d = g->dim, zero[VPDS_MAX_DIM] = {0};
+    size_t rows = 0;
+    int64_t span = (int64_t)g->pad;
+    g->own_tag = VPDSI_BGRID_TAG(0, row_width(d, side, reach, g->pad, zero));
+    o[0] = 0;
+    for (k = 1; k < d; k++) o[k] = -(int)span;
+    for (;;) {
+        int w = row_width(d, side, reach, g->pad, o);
+        if (w >= 0) {
+            int64_t off = 0;
+            if (vpdsi_mem_reserve(m, (void **)&g->row, &g->cap_row, rows + 1, sizeof *g->row) ||
+                vpdsi_mem_reserve(m, (void **)&g->row_w, &g->cap_row_w, rows + 1, sizeof *g->row_w))
+                return -1;
+            for (k = 1; k < d; k++) off += (int64_t)o[k] * (int64_t)g->stride[k];
+            g->row[rows] = off;
+            g->row_w[rows] = w;
+            rows++;
+        }
+        for (k = 1; k < d; k++) {
+            if (++o[k] <= (int)span) break;
+            o[k] = -(int)span;
+        }
+        if (k >= d) break;
+    }
+    g->n_rows = rows;
+    return 0;
 }
 
 int vpdsi_bgrid_setup(vpdsi_bgrid *g, vpdsi_mem *m, int dim, const uint64_t *n, const double *lo,
@@ -79,6 +142,8 @@ int vpdsi_bgrid_setup(vpdsi_bgrid *g, vpdsi_mem *m, int dim, const uint64_t *n, 
             for (k = 0; k < dim; k++) c2 += (double)o[k] * o[k] * side[k] * side[k];
             tmp[count].offset = off;
             tmp[count].d2 = c2;
+            tmp[count].o0 = o[0];
+            tmp[count].w = row_width(dim, side, reach, span, o);
             count++;
         }
         for (k = 0; k < dim; k++) {
@@ -95,9 +160,15 @@ int vpdsi_bgrid_setup(vpdsi_bgrid *g, vpdsi_mem *m, int dim, const uint64_t *n, 
         tmp[j] = e;
     }
     if (vpdsi_mem_reserve(m, (void **)&g->stencil, &g->cap_stencil, count, sizeof *g->stencil) ||
-        vpdsi_mem_reserve(m, (void **)&g->cell, &g->cap_cell, (size_t)total, sizeof *g->cell))
+        vpdsi_mem_reserve(m, (void **)&g->stencil_tag, &g->cap_stencil_tag, count,
+                          sizeof *g->stencil_tag) ||
+        vpdsi_mem_reserve(m, (void **)&g->cell, &g->cap_cell, (size_t)total, sizeof *g->cell) ||
+        setup_rows(g, m, side, reach))
         goto oom;
-    for (i = 0; i < count; i++) g->stencil[i] = tmp[i].offset;
+    for (i = 0; i < count; i++) {
+        g->stencil[i] = tmp[i].offset;
+        g->stencil_tag[i] = VPDSI_BGRID_TAG(tmp[i].o0, tmp[i].w);
+    }
     vpdsi_mem_free(m, tmp, cap_tmp * sizeof *tmp);
     for (i = 0; i < (size_t)total; i++) g->cell[i] = -1;
     g->n_stencil = count;
@@ -189,6 +260,49 @@ void vpdsi_bgrid_prefetch(const vpdsi_bgrid *g, const double *x, const double *y
             asked++;
         }
     }
+}
+
+size_t vpdsi_bgrid_near_packed(const vpdsi_bgrid *g, const double *x, uint64_t at, int32_t *out,
+                               double *px, uint16_t *tag)
+{
+    const int32_t *cell = g->cell + at;
+    size_t found = 0, j, d = (size_t)g->dim;
+    if (cell[0] >= 0) {
+        tag[found] = g->own_tag;
+        out[found++] = cell[0];
+    }
+    for (j = 0; j < g->n_stencil; j++) {
+        int32_t i = cell[g->stencil[j]];
+        if (i >= 0) {
+            tag[found] = g->stencil_tag[j];
+            out[found++] = i;
+        }
+    }
+    for (j = 0; j < found; j++) memcpy(px + j * d, x + (size_t)out[j] * d, d * sizeof *px);
+    return found;
+}
+
+size_t vpdsi_bgrid_slide(const vpdsi_bgrid *g, const double *x, uint64_t at, int32_t *out,
+                         double *px, uint16_t *tag, size_t n)
+{
+    size_t kept = 0, j, r, d = (size_t)g->dim;
+    for (j = 0; j < n; j++) { /* one cell further back: the trailing ones leave */
+        int o0 = VPDSI_BGRID_TAG_O0(tag[j]) - 1, w = VPDSI_BGRID_TAG_W(tag[j]);
+        if (o0 < -w) continue;
+        out[kept] = out[j];
+        tag[kept] = VPDSI_BGRID_TAG(o0, w);
+        if (kept != j) memmove(px + kept * d, px + j * d, d * sizeof *px);
+        kept++;
+    }
+    for (r = 0; r < g->n_rows; r++) { /* each row's leading cell comes in */
+        int32_t i = g->cell[(int64_t)at + g->row[r] + g->row_w[r]];
+        if (i < 0) continue;
+        out[kept] = i;
+        tag[kept] = VPDSI_BGRID_TAG(g->row_w[r], g->row_w[r]);
+        memcpy(px + kept * d, x + (size_t)i * d, d * sizeof *px);
+        kept++;
+    }
+    return kept;
 }
 
 int32_t vpdsi_bgrid_conflict(const vpdsi_bgrid *g, const double *x, const double *y, double reach)

@@ -17,7 +17,20 @@ typedef struct vpdsi_bgrid {
     size_t cap_cell, count;
     int64_t *stencil;              /* linear offsets, nearest cells first */
     size_t n_stencil, cap_stencil;
+    uint16_t *stencil_tag;         /* per offset: VPDSI_BGRID_TAG of its axis-0 offset, row width */
+    size_t cap_stencil_tag;
+    int64_t *row;                  /* the stencil's rows along axis 0: the offset of each
+                                      row's cell at axis-0 offset 0 ... */
+    int *row_w;                    /* ... and the largest axis-0 offset in it */
+    size_t n_rows, cap_row, cap_row_w;
+    uint16_t own_tag;              /* the tag of the centre cell */
 } vpdsi_bgrid;
+
+/* A candidate's place in the stencil, for vpdsi_bgrid_slide: its cell's axis-0 offset o0 and
+ * the half-width w of its row (|o0| <= w <= 8). */
+#define VPDSI_BGRID_TAG(o0, w) ((uint16_t)(((o0) + 64) | ((w) << 8)))
+#define VPDSI_BGRID_TAG_O0(t) ((int)((t) & 0xffu) - 64)
+#define VPDSI_BGRID_TAG_W(t) ((int)((t) >> 8))
 
 /* Past 5D the stencil (some 20,000 cells in 6D) costs more than the kd-tree's queries (1.47 s
  * against 0.25 s at r = 0.6). */
@@ -56,6 +69,15 @@ size_t vpdsi_bgrid_near(const vpdsi_bgrid *g, uint64_t at, int32_t *out);
  * (the samples in the order of their acceptance), and the chunk's darts are drawn before they
  * are judged. A hint only: nothing changes. */
 void vpdsi_bgrid_prefetch(const vpdsi_bgrid *g, const double *x, const double *y, int stage);
+/* vpdsi_bgrid_near with, per sample, its tag and its point (d doubles, from x) into px. */
+size_t vpdsi_bgrid_near_packed(const vpdsi_bgrid *g, const double *x, uint64_t at, int32_t *out,
+                               double *px, uint16_t *tag);
+/* The same list for base cell at made from the n of base cell at - 1 (the one before it on axis
+ * 0): the samples of that stencil's trailing cells dropped (the rest keep their order), those of
+ * the new stencil's leading cells appended; a row's cells, not the whole stencil, are read (in 4D
+ * about 200 of 840). The same set of samples as vpdsi_bgrid_near_packed, in another order. */
+size_t vpdsi_bgrid_slide(const vpdsi_bgrid *g, const double *x, uint64_t at, int32_t *out,
+                         double *px, uint16_t *tag, size_t n);
 /* The first sample within reach of y (strictly nearer), or -1; x holds the samples' points. */
 int32_t vpdsi_bgrid_conflict(const vpdsi_bgrid *g, const double *x, const double *y, double reach);
 #endif

@@ -44,6 +44,7 @@ void vpdsi_mps_release(vpdsi_mps *m, vpdsi_store *st)
     vpdsi_mps_release_cells(m, st);
     vpdsi_mem_free(st->mem, m->cand, m->cap_cand * sizeof(int32_t));
     vpdsi_mem_free(st->mem, m->cand_x, m->cap_cand_x * sizeof(double));
+    vpdsi_mem_free(st->mem, m->cand_tag, m->cap_cand_tag * sizeof(uint16_t));
     vpdsi_mem_free(st->mem, m->strip.idx, m->strip.cap * sizeof(int32_t));
     vpdsi_mem_free(st->mem, m->base.idx, m->base.cap * sizeof(int32_t));
     memset(&m->strip, 0, sizeof m->strip);
@@ -54,7 +55,9 @@ void vpdsi_mps_release(vpdsi_mps *m, vpdsi_store *st)
     vpdsi_uncovered_release(&m->unc, st->mem);
     m->cand = NULL;
     m->cand_x = NULL;
+    m->cand_tag = NULL;
     m->buf_x = m->buf_r = m->buf_u = NULL;
+    m->cap_cand_tag = 0;
     m->cap_cand = m->cap_cand_x = m->cap_buf_x = m->cap_buf_r = m->cap_buf_u = 0;
 }
 
@@ -105,6 +108,8 @@ static vpds_status choose_index(vpdsi_mps *m, const vpdsi_ctx *ctx, int keep_tre
                           sizeof(int32_t)) == 0 &&
         vpdsi_mem_reserve(ctx->mem, (void **)&m->cand_x, &m->cap_cand_x,
                           (st->grid.n_stencil + 1) * (size_t)pb->dim, sizeof(double)) == 0 &&
+        vpdsi_mem_reserve(ctx->mem, (void **)&m->cand_tag, &m->cap_cand_tag, st->grid.n_stencil + 1,
+                          sizeof(uint16_t)) == 0 &&
         grid_index_all(st, pb) == 0) {
         st->grid_mode = 1;
         return VPDS_OK;
@@ -678,12 +683,18 @@ static vpds_status gather_near(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_
         at = vpdsi_bgrid_index(&st->grid, base);
         /* the cells of one base cell come one after another: its list serves them all while
          * no sample comes (in 4D its stencil reads 609 grid cells), keyed as near_lists keys */
-        if (m->base.key != at + 1 || m->base.store_n != st->n) {
-            size_t j, d = (size_t)pb->dim, k;
-            m->n_cand = vpdsi_bgrid_near(&st->grid, at, m->cand);
+        if (m->base.key == at && m->base.store_n == st->n) {
+            /* the base cell before this one on axis 0 (lattice order, as level 0 sweeps them):
+             * its list slides one cell on, reading the stencil's leading face only; the tests
+             * that read it (packed_cover, box_covered) ask whether any of them covers: the
+             * order of the list changes nothing */
+            m->n_cand = vpdsi_bgrid_slide(&st->grid, st->x, at, m->cand, m->cand_x, m->cand_tag,
+                                          m->n_cand);
+            m->base.key = at + 1;
+        } else if (m->base.key != at + 1 || m->base.store_n != st->n) {
             /* packed once, read by every cell of the base cell (packed_cover) */
-            for (j = 0; j < m->n_cand; j++)
-                for (k = 0; k < d; k++) m->cand_x[j * d + k] = st->x[(size_t)m->cand[j] * d + k];
+            m->n_cand = vpdsi_bgrid_near_packed(&st->grid, st->x, at, m->cand, m->cand_x,
+                                                m->cand_tag);
             m->base.key = at + 1;
             m->base.store_n = st->n;
         }

@@ -42,6 +42,7 @@ typedef struct vpdsi_mps {
     vpdsi_run run;
     int32_t *cand; size_t n_cand, cap_cand; /* the samples near the cell being swept */
     double *cand_x; size_t cap_cand_x;      /* background grid: their coordinates, d apart */
+    uint16_t *cand_tag; size_t cap_cand_tag; /* ... and their places (vpdsi_bgrid_slide) */
     double *buf_x; size_t cap_buf_x;        /* a chunk's darts or cell centres */
     double *buf_r; size_t cap_buf_r;        /* r there */
     double *buf_u; size_t cap_buf_u;        /* weighted mode: the acceptance draw of each dart */
