@@ -16,6 +16,9 @@
 #ifndef VPDSI_GRID_LIST_CAP /* tests/determinism.sh builds one tool with a tiny one */
 #define VPDSI_GRID_LIST_CAP LIST_CAP /* a grid's list longer than this: the kd-tree serves */
 #endif
+#if VPDSI_GRID_LIST_CAP > LIST_CAP || VPDSI_GRID_LIST_CAP < 1
+#error "VPDSI_GRID_LIST_CAP must lie in 1..LIST_CAP: a list fills one slot of LIST_CAP"
+#endif
 
 /* Every box of a search used to walk the kd-trees from their roots, several times; a search
  * examines thousands of boxes, most of them deep and small. Instead each box keeps two lists
@@ -101,9 +104,13 @@ static int near_uncovered(bb_search *q, int depth, const double *c2, double thr)
 
 /* With one radius the run's background grid holds every sample near a box that lies in one of
  * its cells: its stencil reaches t * inhibition * r, no less than the coverage reach, with a
- * margin of 1e-6 (bgrid.c), above the lists' 1e-9. The box's list comes from there, and the
- * kd-tree is not built (its build took a sixth of an annulus run). 0: the list is in slot off;
- * 1: the box spans cells or the list overflows, the kd-tree must serve. */
+ * margin of 1e-6 (bgrid.c), above the lists' 1e-9 (their slack of 1e-12 times the largest
+ * coordinate may reach past it far from the origin, but only for samples too far to cover: the
+ * tests are strict). The box's list comes from there, and the kd-tree is not built (its build
+ * took a sixth of an annulus run). The list's order (nearest cells first) is not the tree's:
+ * the answers are the same, but far_corner's corner, and so the boxes a search counts against
+ * a budget, may differ. 0: the list is in slot off; 1: the box spans cells or the list
+ * overflows, the kd-tree must serve. */
 static int grid_list(bb_search *q, const double *lo, const double *hi, double rb, size_t off,
                      size_t *count)
 {
