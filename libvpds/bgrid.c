@@ -40,8 +40,8 @@ double vpdsi_bgrid_cells(int dim, const double *n, const double *side, double re
     return total;
 }
 
-/* Whether the cell at offsets o lies in the stencil (or is the centre): the test of the
- * stencil's loop below, in its order of sums. */
+/* Whether the cell at offsets o lies within reach of the centre cell (the centre itself too),
+ * with a margin for the rounding of a point's cell index: the stencil's test, and its rows'. */
 static int in_stencil(int dim, const double *side, double reach, const int *o)
 {
     double d2 = 0;
@@ -126,17 +126,13 @@ int vpdsi_bgrid_setup(vpdsi_bgrid *g, vpdsi_mem *m, int dim, const uint64_t *n, 
      * rounding of a point's cell index */
     for (k = 0; k < dim; k++) o[k] = -(int)span;
     for (;;) {
-        double d2 = 0;
         int zero = 1;
         int64_t off = 0;
         for (k = 0; k < dim; k++) {
-            int a = o[k] < 0 ? -o[k] : o[k];
-            double gap = a > 1 ? (a - 1) * side[k] : 0;
-            d2 += gap * gap;
             if (o[k]) zero = 0;
             off += (int64_t)o[k] * (int64_t)g->stride[k];
         }
-        if (!zero && d2 < reach * reach * (1 + 1e-6)) {
+        if (!zero && in_stencil(dim, side, reach, o)) {
             double c2 = 0;
             if (vpdsi_mem_reserve(m, (void **)&tmp, &cap_tmp, count + 1, sizeof *tmp)) goto oom;
             for (k = 0; k < dim; k++) c2 += (double)o[k] * o[k] * side[k] * side[k];

@@ -211,8 +211,6 @@ static uint64_t cur_count(const vpdsi_mps *m)
     return m->run.implicit ? m->run.base_count : (uint64_t)m->run.cur.count;
 }
 
-/* n darts into out (n*dim): a cell uniformly, then a point uniformly in it; in weighted mode
- * one more uniform per dart into u, for its acceptance (Eq. 12). */
 #ifndef CELL_PREFETCH
 #define CELL_PREFETCH 8 /* darts ahead whose cells are asked for */
 #endif
@@ -226,6 +224,8 @@ static void prefetch_ahead(const vpdsi_mps *m, vpdsi_rng *ahead, uint64_t total,
     for (k = 0; k < d + with_u; k++) (void)vpdsi_rng_unit(ahead);
 }
 
+/* n darts into out (n*dim): a cell uniformly, then a point uniformly in it; in weighted mode
+ * one more uniform per dart into u, for its acceptance (Eq. 12). */
 static void draw_darts(const vpdsi_mps *m, const vpdsi_ctx *ctx, vpdsi_rng *rng, size_t n, double *out, double *u)
 {
     uint64_t c[VPDS_MAX_DIM], total = cur_count(m);
