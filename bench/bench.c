@@ -1,5 +1,6 @@
 #define _POSIX_C_SOURCE 199309L
-/* libvpds workloads for `make bench`. Prints "name n seconds peak_bytes" per line.
+/* libvpds workloads for `make bench`. Prints "name n seconds peak_bytes" per line (with
+ * VPDS_BENCH_COUNTS set, a run's and a mesh run's work counters too, on stderr).
  * usage: bench uniform DIM RADIUS | tworadii DIM RADIUS INHIBITION [VERSION] | ramp RULE | floor N DIM
  *        | tworamp3 VERSION [INHIBITION] (3D two radii R_f = INHIBITION R_c (0.5), r = 0.03 + 0.12 x0, periodic axes 1 and 2,
  *          rule bigger, at algorithm_version VERSION: a fuzz input's workload)
@@ -40,6 +41,15 @@ static double annulus(const double *x, void *u)
     return r - 0.45 > 0.2 - r ? r - 0.45 : 0.2 - r;
 }
 
+/* With VPDS_BENCH_COUNTS set, the run's work counters on stderr (darts, levels, peak cells). */
+static void print_counts(const vpds_stats *stats)
+{
+    if (!getenv("VPDS_BENCH_COUNTS")) return;
+    fprintf(stderr, "darts %llu accepted %llu levels %u peak_active_cells %llu sizing_calls %llu\n",
+            (unsigned long long)stats->darts, (unsigned long long)stats->accepted, (unsigned)stats->levels,
+            (unsigned long long)stats->peak_active_cells, (unsigned long long)stats->sizing_calls);
+}
+
 static int run(const char *name, vpds_desc *d)
 {
     vpds_sampler *s;
@@ -55,6 +65,7 @@ static int run(const char *name, vpds_desc *d)
     }
     stats = vpds_get_stats(s);
     printf("%s %zu %.6f %zu\n", name, vpds_count(s), now() - t0, stats.peak_bytes);
+    print_counts(&stats);
     vpds_destroy(s);
     return 0;
 }
@@ -269,6 +280,10 @@ static int run_mesh(const char *name, const double *v, size_t nv, const uint32_t
         return 1;
     }
     printf("%s %zu %.6f %zu\n", name, vpds_mesh_count(m), now() - t0, vpds_mesh_get_stats(m).peak_bytes);
+    {
+        vpds_stats stats = vpds_mesh_get_stats(m);
+        print_counts(&stats);
+    }
     vpds_mesh_destroy(m);
     return 0;
 }

@@ -21,6 +21,7 @@
 void vpdsi_mps_init(vpdsi_mps *m, int dim, const double *period)
 {
     memset(m, 0, sizeof *m);
+    m->holder = -1;
     vpdsi_uncovered_init(&m->unc, dim, period);
     vpdsi_mps_reset(m, 1.0);
 }
@@ -346,7 +347,7 @@ static vpds_status judge_dart(vpdsi_mps *m, const vpdsi_ctx *ctx, const double *
 }
 
 #ifndef DART_PREFETCH
-#define DART_PREFETCH 8 /* darts ahead whose cells and samples are asked for (vpdsi_bgrid_prefetch) */
+#define DART_PREFETCH 8 /* darts ahead whose cells and samples are asked for (vpdsi_store_prefetch) */
 #endif
 static vpds_status darts_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
 {
@@ -360,10 +361,10 @@ static vpds_status darts_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
     for (j = 0; j < n; j++) {
         const double *y = m->buf_x + j * (size_t)ctx->pb->dim;
         int accept;
-        if (st->grid_mode && j + 2 * DART_PREFETCH < n)
-            vpdsi_bgrid_prefetch(&st->grid, st->x, y + 2 * DART_PREFETCH * (size_t)ctx->pb->dim, 0);
-        if (st->grid_mode && j + DART_PREFETCH < n)
-            vpdsi_bgrid_prefetch(&st->grid, st->x, y + DART_PREFETCH * (size_t)ctx->pb->dim, 1);
+        if (j + 2 * DART_PREFETCH < n)
+            vpdsi_store_prefetch(st, y + 2 * DART_PREFETCH * (size_t)ctx->pb->dim, m->buf_r[j + 2 * DART_PREFETCH], 0);
+        if (j + DART_PREFETCH < n)
+            vpdsi_store_prefetch(st, y + DART_PREFETCH * (size_t)ctx->pb->dim, m->buf_r[j + DART_PREFETCH], 1);
         if (weighted && m->buf_u[j] == 0.0) continue;
         if ((e = judge_dart(m, ctx, y, m->buf_r[j], &accept)) != VPDS_OK) {
             /* keep the darts before this one, as a pause would */
@@ -385,11 +386,37 @@ static vpds_status darts_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
     return VPDS_OK;
 }
 
+/* The candidate that holds the box [lo, hi] whole (vpdsi_kd_box_covered), or -1. */
+static int32_t box_holder(const vpdsi_mps *m, const vpdsi_ctx *ctx, const double *lo, const double *hi,
+                          double r_lo, double scale)
+{
+    vpdsi_kd_samples view = vpdsi_store_view(ctx->st);
+    size_t j;
+    for (j = 0; j < m->n_cand; j++)
+        if (vpdsi_kd_box_covered(&ctx->st->tree, &view, m->cand + j, 1, lo, hi, r_lo, (int)ctx->pb->rule, scale))
+            return m->cand[j];
+    return -1;
+}
+
 static int box_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, const double *lo, const double *hi, double r_lo,
                        double scale)
 {
-    vpdsi_kd_samples view = vpdsi_store_view(ctx->st);
-    return vpdsi_kd_box_covered(&ctx->st->tree, &view, m->cand, m->n_cand, lo, hi, r_lo, (int)ctx->pb->rule, scale);
+    return box_holder(m, ctx, lo, hi, r_lo, scale) >= 0;
+}
+
+/* Octave grid: the sample that held the cell dropped last holds most next ones too (on the
+ * ramp 2 of 3 dropped cells). When it holds this cell and the gather would list it,
+ * box_covered on the gathered list would find it: the cell is dropped without the gather. */
+static int holder_covers(const vpdsi_mps *m, const vpdsi_ctx *ctx, const double *lo, const double *hi,
+                         double r_lo, double r_hi, double scale, int split)
+{
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_kd_samples view;
+    double gather_scale = m->run.t * (pb->two_radii ? pb->coverage : pb->inhibition);
+    if (!ctx->st->ogrid_mode || m->holder < 0 || (size_t)m->holder >= ctx->st->n) return 0;
+    view = vpdsi_store_view(ctx->st);
+    return vpdsi_kd_box_covered(&ctx->st->tree, &view, &m->holder, 1, lo, hi, r_lo, (int)pb->rule, scale) &&
+           vpdsi_ogrid_gathers(&view, pb->dim, m->holder, lo, hi, r_hi, (int)pb->rule, gather_scale, split);
 }
 
 /* Children are decided BLOCK_CHILDREN at a time: all of them up to 8D, 2^(d-8) blocks past. */
@@ -835,6 +862,7 @@ static vpds_status sweep_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t
     size_t kept = run->next.count, records = m->unc.n_nwit;
     uint64_t known[4] = {0, 0, 0, 0};
     const uint64_t *pre = NULL; /* the children's bits when decided here */
+    int32_t holder;
     vpds_status e;
     if (ctx->dom->fn) {
         for (k = 0; k < d; k++) centre[k] = 0.5 * (lo[k] + hi[k]);
@@ -842,11 +870,13 @@ static vpds_status sweep_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t
         if (phi > 0.5 * h) return VPDS_OK; /* outside the domain, whole */
     }
     if (st->grid_mode && occupant_covers(ctx, level, c, lo, hi, scale * st->sizing.radius)) return VPDS_OK;
+    if (holder_covers(m, ctx, lo, hi, r_lo, r_hi, scale, split)) return VPDS_OK;
     if ((e = gather_near(m, ctx, c, level, lo, hi, r_hi, split)) != VPDS_OK) return e;
     if (st->grid_mode && split) { /* one radius, open axes, one block: one pass decides all */
         if (packed_cover(m, d, level, c, scale * st->sizing.radius, known)) return VPDS_OK;
         pre = known;
-    } else if (box_covered(m, ctx, lo, hi, r_lo, scale)) {
+    } else if ((holder = box_holder(m, ctx, lo, hi, r_lo, scale)) >= 0) {
+        m->holder = holder;
         return VPDS_OK;
     }
     if (pb->two_radii) whole_c = box_covered(m, ctx, lo, hi, r_lo, run->t * pb->coverage);

@@ -41,6 +41,8 @@ typedef struct vpdsi_near_list {
 typedef struct vpdsi_mps {
     vpdsi_run run;
     int32_t *cand; size_t n_cand, cap_cand; /* the samples near the cell being swept */
+    int32_t holder;                         /* octave grid: the sample that held the last
+                                               cell dropped, or -1 */
     double *cand_x; size_t cap_cand_x;      /* background grid: their coordinates, d apart */
     uint16_t *cand_tag; size_t cap_cand_tag; /* ... and their places (vpdsi_bgrid_slide) */
     double *buf_x; size_t cap_buf_x;        /* a chunk's darts or cell centres */

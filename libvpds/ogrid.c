@@ -258,6 +258,31 @@ static int next_range_cell(const vpdsi_ogrid *g, int l, const uint64_t *a, const
     return 1;
 }
 
+void vpdsi_ogrid_prefetch(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const double *y,
+                          double ry, int stage)
+{
+    int l = level_of(g, ry), k;
+    const vpdsi_ogrid_level *lv = &g->lv[l];
+    uint64_t c[3], key;
+    size_t j;
+    if (g->cap == 0 || lv->count == 0) return;
+    for (k = 0; k < g->dim; k++) c[k] = cell_at(g, l, k, y[k], 0, CELL_MAX);
+    key = key_of(l, c, g->dim);
+    if (stage == 0) {
+        j = (size_t)vpdsi_mix64(key) & (g->cap - 1);
+        VPDSI_PREFETCH(g->keys + j);
+        VPDSI_PREFETCH(g->heads + j);
+        return;
+    }
+    j = slot_of(g, key);
+    if (g->keys[j]) {
+        int32_t i = g->heads[j];
+        VPDSI_PREFETCH(s->x + (size_t)i * (size_t)g->dim);
+        VPDSI_PREFETCH(s->r + i);
+        VPDSI_PREFETCH(g->next + i);
+    }
+}
+
 int32_t vpdsi_ogrid_conflict(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const double *y,
                              double ry, int rule, double scale, double lipschitz,
                              int32_t *witness)
@@ -321,6 +346,14 @@ int vpdsi_ogrid_gather(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const do
         }
     }
     return 0;
+}
+
+int vpdsi_ogrid_gathers(const vpdsi_kd_samples *s, int dim, int32_t i, const double *lo,
+                        const double *hi, double r_hi, int rule, double scale, int split)
+{
+    double c0[3], c1[3], w[3];
+    vpdsi_prox_gather_centres(dim, lo, hi, split, c0, c1, w);
+    return vpdsi_prox_may_cover(s, i, dim, open_axes, c0, c1, w, r_hi, rule, scale);
 }
 
 int vpdsi_ogrid_near_box(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const double *lo,

@@ -47,6 +47,16 @@ int32_t vpdsi_ogrid_conflict(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, co
 int vpdsi_ogrid_gather(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const double *lo,
                        const double *hi, double r_hi, int rule, double scale, int split,
                        vpdsi_mem *m, int32_t **out, size_t *count, size_t *cap);
+/* Whether vpdsi_ogrid_gather(lo, hi, r_hi, rule, scale, split) lists sample i: its test of
+ * the sample, which passes only within the reach that its cell ranges read (widened). */
+int vpdsi_ogrid_gathers(const vpdsi_kd_samples *s, int dim, int32_t i, const double *lo,
+                        const double *hi, double r_hi, int rule, double scale, int split);
+/* Ask the caches for what a conflict query at y (radius ry) reads first, a few queries ahead:
+ * stage 0 the table's slots of the cells around y at ry's level, stage 1 (once those are in)
+ * the point, radius and chain link of the newest sample of each. Reads nothing it does not own;
+ * changes nothing. */
+void vpdsi_ogrid_prefetch(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const double *y,
+                          double ry, int stage);
 /* vpdsi_kd_near_box on the grid, without a limit: every sample near the box, appended to *out
  * (grown with m); -1 on OOM. */
 int vpdsi_ogrid_near_box(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const double *lo,

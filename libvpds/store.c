@@ -186,6 +186,16 @@ int32_t vpdsi_store_conflict(const vpdsi_store *st, const double *y, double ry, 
     return vpdsi_kd_conflict(&st->tree, &v, y, ry, rule, scale, lipschitz, witness);
 }
 
+void vpdsi_store_prefetch(const vpdsi_store *st, const double *y, double ry, int stage)
+{
+    if (st->grid_mode) {
+        vpdsi_bgrid_prefetch(&st->grid, st->x, y, stage);
+    } else if (st->ogrid_mode) {
+        vpdsi_kd_samples v = vpdsi_store_view(st);
+        vpdsi_ogrid_prefetch(&st->ogrid, &v, y, ry, stage);
+    }
+}
+
 int vpdsi_store_gather(const vpdsi_store *st, const double *lo, const double *hi, double r_hi,
                        int rule, double scale, int split, int32_t **out, size_t *count,
                        size_t *cap)

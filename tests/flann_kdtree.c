@@ -163,6 +163,14 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
                         CHECK_MSG(a == (size_t)n && cnt == cnt2, "%s: octave grid gather (rule %d, "
                                   "split %d) differs from the kd-tree's: %zu against %zu", name, rule,
                                   split, cnt2, cnt);
+                        /* its per-sample test (the sweep's shortcut for the last holder) names
+                         * exactly the samples it gathers */
+                        for (a = 0; a < (size_t)n; a++)
+                            if (vpdsi_ogrid_gathers(&s, dim, (int32_t)a, lo, hi, rp, rule, 1.0, split) !=
+                                ((mark[a] & 2) != 0))
+                                break;
+                        CHECK_MSG(a == (size_t)n, "%s: vpdsi_ogrid_gathers (rule %d, split %d) and "
+                                  "the gather disagree on sample %zu", name, rule, split, a);
                     }
                     cnt = 0;
                     CHECK(vpdsi_kd_gather(&t, &s, lo, hi, rp, rule, 1.0, 0, &m, &out, &cnt, &cap) == 0);
