@@ -258,6 +258,13 @@ void vpdsi_bgrid_prefetch(const vpdsi_bgrid *g, const double *x, const double *y
     }
 }
 
+/* d coordinates, forwards (a library call per point cost 15% of a 2D run) */
+static void copy_point(double *to, const double *from, size_t d)
+{
+    size_t k;
+    for (k = 0; k < d; k++) to[k] = from[k];
+}
+
 size_t vpdsi_bgrid_near_packed(const vpdsi_bgrid *g, const double *x, uint64_t at, int32_t *out,
                                double *px, uint16_t *tag)
 {
@@ -274,7 +281,7 @@ size_t vpdsi_bgrid_near_packed(const vpdsi_bgrid *g, const double *x, uint64_t a
             out[found++] = i;
         }
     }
-    for (j = 0; j < found; j++) memcpy(px + j * d, x + (size_t)out[j] * d, d * sizeof *px);
+    for (j = 0; j < found; j++) copy_point(px + j * d, x + (size_t)out[j] * d, d);
     return found;
 }
 
@@ -287,7 +294,7 @@ size_t vpdsi_bgrid_slide(const vpdsi_bgrid *g, const double *x, uint64_t at, int
         if (o0 < -w) continue;
         out[kept] = out[j];
         tag[kept] = VPDSI_BGRID_TAG(o0, w);
-        if (kept != j) memmove(px + kept * d, px + j * d, d * sizeof *px);
+        if (kept != j) copy_point(px + kept * d, px + j * d, d); /* kept < j: forwards is safe */
         kept++;
     }
     for (r = 0; r < g->n_rows; r++) { /* each row's leading cell comes in */
@@ -295,7 +302,7 @@ size_t vpdsi_bgrid_slide(const vpdsi_bgrid *g, const double *x, uint64_t at, int
         if (i < 0) continue;
         out[kept] = i;
         tag[kept] = VPDSI_BGRID_TAG(g->row_w[r], g->row_w[r]);
-        memcpy(px + kept * d, x + (size_t)i * d, d * sizeof *px);
+        copy_point(px + kept * d, x + (size_t)i * d, d);
         kept++;
     }
     return kept;
