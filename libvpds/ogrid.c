@@ -283,34 +283,49 @@ void vpdsi_ogrid_prefetch(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const
     }
 }
 
+/* The conflict test over the chain from sample i: the first sample that conflicts, -2 (its
+ * index in *witness) at a broken Lipschitz bound, -1 when none does. */
+static int32_t chain_conflict(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, int32_t i,
+                              const double *y, double ry, int rule, double scale,
+                              double lipschitz, int32_t *witness)
+{
+    for (; i >= 0; i = g->next[i]) {
+        int hit = vpdsi_prox_conflict(s, i, g->dim, open_axes, y, ry, rule, scale, lipschitz);
+        if (hit == -2) {
+            *witness = i;
+            return -2;
+        }
+        if (hit) return i;
+    }
+    return -1;
+}
+
 int32_t vpdsi_ogrid_conflict(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const double *y,
                              double ry, int rule, double scale, double lipschitz,
                              int32_t *witness)
 {
-    int home = level_of(g, ry), step;
+    int home = level_of(g, ry), step, k;
     /* the level of ry first, then outwards: conflicts are likeliest among similar radii */
     for (step = 0; step < 2 * g->levels; step++) {
         int l = home + (step % 2 ? (step + 1) / 2 : -(step / 2));
-        uint64_t a[3], b[3], c[3];
+        uint64_t a[3], b[3], c[3], yc[3];
         size_t pos = 0;
-        int32_t i;
+        int32_t i, hit;
         int scan;
         double reach;
         if (l < 0 || l >= g->levels || g->lv[l].count == 0) continue;
         reach = scale * vpdsi_rule_f((vpds_rule)rule, g->lv[l].rmax, ry);
         if (!cell_range(g, l, y, y, reach, a, b)) continue;
+        /* the cell of y first (a conflict lies likeliest there), then the rest of the range */
+        for (k = 0; k < g->dim; k++) yc[k] = cell_at(g, l, k, y[k], a[k], b[k]);
+        if (!cell_beyond(g, l, yc, y, y, reach) &&
+            (hit = chain_conflict(g, s, head_of(g, l, yc), y, ry, rule, scale, lipschitz, witness)) != -1)
+            return hit;
         scan = range_cells(g->dim, a, b) > (double)g->cap;
         while (next_range_cell(g, l, a, b, scan, c, &pos, &i)) {
-            if (i < 0 || cell_beyond(g, l, c, y, y, reach)) continue;
-            for (; i >= 0; i = g->next[i]) {
-                int hit = vpdsi_prox_conflict(s, i, g->dim, open_axes, y, ry, rule, scale,
-                                              lipschitz);
-                if (hit == -2) {
-                    *witness = i;
-                    return -2;
-                }
-                if (hit) return i;
-            }
+            if (i < 0 || !memcmp(c, yc, (size_t)g->dim * sizeof *c) || cell_beyond(g, l, c, y, y, reach))
+                continue;
+            if ((hit = chain_conflict(g, s, i, y, ry, rule, scale, lipschitz, witness)) != -1) return hit;
         }
     }
     return -1;
