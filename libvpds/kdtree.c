@@ -280,14 +280,21 @@ int vpdsi_kd_radius(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const doub
     return 0;
 }
 
+int32_t vpdsi_kd_box_holder(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *cand,
+                            size_t n, const double *lo, const double *hi, double r_lo, int rule,
+                            double scale)
+{
+    size_t j;
+    for (j = 0; j < n; j++)
+        if (covers_box(t, s, cand[j], lo, hi, r_lo, rule, scale)) return cand[j];
+    return -1;
+}
+
 int vpdsi_kd_box_covered(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *cand,
                          size_t n, const double *lo, const double *hi, double r_lo, int rule,
                          double scale)
 {
-    size_t j;
-    for (j = 0; j < n; j++)
-        if (covers_box(t, s, cand[j], lo, hi, r_lo, rule, scale)) return 1;
-    return 0;
+    return vpdsi_kd_box_holder(t, s, cand, n, lo, hi, r_lo, rule, scale) >= 0;
 }
 
 double vpdsi_kd_min_ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *y,

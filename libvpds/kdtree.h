@@ -66,6 +66,10 @@ int vpdsi_kd_gather(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const doub
 int vpdsi_kd_box_covered(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *cand,
                          size_t n, const double *lo, const double *hi, double r_lo, int rule,
                          double scale);
+/* The same test: the first candidate that holds the box whole, or -1. */
+int32_t vpdsi_kd_box_holder(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const int32_t *cand,
+                            size_t n, const double *lo, const double *hi, double r_lo, int rule,
+                            double scale);
 
 /* Whether some sample has |y - x| / r(x) <= bound (vpdsi_kd_min_ratio's per-sample ratio with
  * the rule prior and no slack), stopping at the first that shows it. */

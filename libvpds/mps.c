@@ -386,16 +386,12 @@ static vpds_status darts_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
     return VPDS_OK;
 }
 
-/* The candidate that holds the box [lo, hi] whole (vpdsi_kd_box_covered), or -1. */
+/* The candidate that holds the box [lo, hi] whole, or -1. */
 static int32_t box_holder(const vpdsi_mps *m, const vpdsi_ctx *ctx, const double *lo, const double *hi,
                           double r_lo, double scale)
 {
     vpdsi_kd_samples view = vpdsi_store_view(ctx->st);
-    size_t j;
-    for (j = 0; j < m->n_cand; j++)
-        if (vpdsi_kd_box_covered(&ctx->st->tree, &view, m->cand + j, 1, lo, hi, r_lo, (int)ctx->pb->rule, scale))
-            return m->cand[j];
-    return -1;
+    return vpdsi_kd_box_holder(&ctx->st->tree, &view, m->cand, m->n_cand, lo, hi, r_lo, (int)ctx->pb->rule, scale);
 }
 
 static int box_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, const double *lo, const double *hi, double r_lo,

@@ -52,9 +52,9 @@ int vpdsi_ogrid_gather(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const do
 int vpdsi_ogrid_gathers(const vpdsi_kd_samples *s, int dim, int32_t i, const double *lo,
                         const double *hi, double r_hi, int rule, double scale, int split);
 /* Ask the caches for what a conflict query at y (radius ry) reads first, a few queries ahead:
- * stage 0 the table's slots of the cells around y at ry's level, stage 1 (once those are in)
- * the point, radius and chain link of the newest sample of each. Reads nothing it does not own;
- * changes nothing. */
+ * stage 0 the table's slot of y's cell at ry's level (the query tests that cell first), stage 1
+ * (once it is in) the point, radius and chain link of that cell's newest sample. Changes
+ * nothing. */
 void vpdsi_ogrid_prefetch(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const double *y,
                           double ry, int stage);
 /* vpdsi_kd_near_box on the grid, without a limit: every sample near the box, appended to *out
