@@ -77,8 +77,12 @@ extern "C" {
  * points are equally far another may come first (other points for vpds_next in 2D; everything
  * else gives the points of version 9). 11: the same in 3D, from the Delaunay tetrahedralisation
  * and, along the box's edges, the lower envelope of the samples' distances (other points for
- * vpds_next in 3D; everything else gives the points of version 10). */
-#define VPDS_ALGORITHM_VERSION 11
+ * vpds_next in 3D; everything else gives the points of version 10). 12: from 6D on, the sweep
+ * of Algorithm 1 also drops a cell that two disks hold together though neither holds it alone
+ * (the ball of their pencil centred on their radical hyperplane, which lies in their union),
+ * so fewer cells split into 2^d children and fewer darts land where nothing is left (other
+ * points for a run or refinement in 6D and up; everything else gives the points of 11). */
+#define VPDS_ALGORITHM_VERSION 12
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 16
 /* Relative tolerance eps of the continuous stream (vpds_next): each t it reports is an upper

@@ -7,6 +7,7 @@
  * region. Work is cut into chunks; between chunks the state is complete, so a pause, an error
  * or an exhausted budget can resume to exactly the points of an uninterrupted run. */
 #include "mps.h"
+#include "pencil.h"
 #include "rules.h"
 #include "torus.h"
 #include <math.h>
@@ -386,6 +387,56 @@ static vpds_status darts_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
     return VPDS_OK;
 }
 
+/* Version 12, on the kd-tree's lists from 6D on: a cell or child that two disks hold together
+ * is dropped as one that one disk holds (pencil.h). Below 6D it cost more than it saved
+ * (README, performance); the background grid and the octave grid do without it. */
+#ifndef VPDSI_PENCIL_MIN_DIM
+#define VPDSI_PENCIL_MIN_DIM 6
+#endif
+static int uses_pencil(const vpdsi_ctx *ctx)
+{
+    return ctx->pb->algorithm >= 12 && ctx->pb->dim >= VPDSI_PENCIL_MIN_DIM && !ctx->st->grid_mode &&
+           !ctx->st->ogrid_mode;
+}
+
+/* Whether one candidate holds the box [lo, hi] whole (as box_holder finds) or, with a pencil
+ * (uses_pencil), the ball of two of them does: one pass over the list for both. */
+static int box_held(const vpdsi_mps *m, const vpdsi_ctx *ctx, const double *lo, const double *hi, double r_lo,
+                    double scale)
+{
+    const vpdsi_problem *pb = ctx->pb;
+    const vpdsi_store *st = ctx->st;
+    int d = pb->dim, k, pair;
+    vpdsi_pencil pen;
+    size_t j;
+    vpdsi_pencil_reset(&pen, d, lo, hi);
+    for (j = 0; j < m->n_cand; j++) {
+        const double *x = st->x + (size_t)m->cand[j] * (size_t)d;
+        double f = scale * vpdsi_rule_f(pb->rule, st->r[m->cand[j]], r_lo), far2 = 0, near2 = 0;
+        if (!(f > 0)) continue;
+        for (k = 0; k < d; k++) {
+            double e = vpdsi_axis_far(x[k], lo[k], hi[k], pb->period[k]);
+            far2 += e * e;
+        }
+        if (far2 <= f * f) return 1; /* box_maxdist2's sum, as covers_box takes it */
+        for (k = 0; k < d; k++) {
+            double g = vpdsi_axis_gap(x[k], lo[k], hi[k], pb->period[k]);
+            near2 += g * g;
+        }
+        if (near2 < f * f) vpdsi_pencil_offer(&pen, d, x, f * f, far2, lo, hi, pb->period);
+    }
+    for (pair = 0; pair < VPDSI_PENCIL_PAIRS; pair++) {
+        double y[VPDS_MAX_DIM], r2, far2 = 0;
+        if (!vpdsi_pencil_ball(&pen, d, pair, y, &r2)) continue;
+        for (k = 0; k < d; k++) {
+            double e = vpdsi_axis_far(y[k], lo[k], hi[k], 0.0);
+            far2 += e * e;
+        }
+        if (far2 <= r2) return 1;
+    }
+    return 0;
+}
+
 /* The candidate that holds the box [lo, hi] whole, or -1. */
 static int32_t box_holder(const vpdsi_mps *m, const vpdsi_ctx *ctx, const double *lo, const double *hi,
                           double r_lo, double scale)
@@ -438,29 +489,66 @@ static int children_all_set(const uint64_t *bits, unsigned n)
     return n % 64 == 0 || bits[n / 64] == (UINT64_C(1) << (n % 64)) - 1;
 }
 
-/* Which children of cell c in block `block` are covered whole by one candidate. A child's
- * farthest point from x is, on each axis, the farther end of its half; so per candidate all
- * children's squared farthest distances are sums of 2 values per axis, built child by child
- * from a neighbour that differs in one axis. Bit j of covered is child (block << 8) + j (bit k
- * of a child's number: upper half on axis k). */
+/* The children of a block held whole by one disk, from its squared farthest distance to each
+ * half of the cell on each axis (far[k][0] the lower half): a child's farthest point from x is,
+ * on each axis, the farther end of its half, so all children's squared farthest distances are
+ * sums of one value per axis, built child by child from a neighbour that differs in one axis.
+ * Bit j of covered is child (block << 8) + j (bit k of a child's number: upper half on axis k). */
+static void disk_children(int d, int low, unsigned block, const double (*far)[2], double f2, uint64_t *covered)
+{
+    unsigned children = 1u << low, b;
+    double sums[BLOCK_CHILDREN];
+    int k;
+    sums[0] = 0;
+    for (k = 0; k < d; k++) sums[0] += far[k][k < low ? 0 : (block >> (k - low)) & 1u];
+    if (sums[0] <= f2) covered[0] |= 1u;
+    for (b = 1; b < children; b++) {
+        unsigned bit = 0;
+        while (!((b >> bit) & 1u)) bit++;
+        sums[b] = sums[b & (b - 1)] - far[bit][0] + far[bit][1];
+        if (sums[b] <= f2) covered[b >> 6] |= UINT64_C(1) << (b & 63u);
+    }
+}
+
+/* Version 12: children that no disk holds alone, tried against the balls of pairs of the disks
+ * that reach into the cell [lo, hi] (pencil.h), as disks are. */
+static void pencil_children(const vpdsi_pencil *pen, int d, int low, unsigned block, const double *lo,
+                            const double *mid, const double *hi, uint64_t *covered)
+{
+    int pair, k;
+    for (pair = 0; pair < VPDSI_PENCIL_PAIRS; pair++) {
+        double y[VPDS_MAX_DIM], r2, far[VPDS_MAX_DIM][2], least = 0;
+        if (!vpdsi_pencil_ball(pen, d, pair, y, &r2)) continue;
+        for (k = 0; k < d; k++) {
+            double a = vpdsi_axis_far(y[k], lo[k], mid[k], 0.0), z = vpdsi_axis_far(y[k], mid[k], hi[k], 0.0);
+            far[k][0] = a * a;
+            far[k][1] = z * z;
+            least += far[k][0] < far[k][1] ? far[k][0] : far[k][1];
+        }
+        if (least <= r2) disk_children(d, low, block, (const double (*)[2])far, r2, covered);
+    }
+}
+
+/* Which children of cell c in block `block` are covered whole by one candidate (disk_children),
+ * and with pen (version 12), by the ball of a pair of them. */
 static void children_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned level, const uint64_t *c, double r_lo,
-                             double scale, unsigned block, uint64_t *covered)
+                             double scale, unsigned block, uint64_t *covered, vpdsi_pencil *pen)
 {
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_store *st = ctx->st;
     int d = pb->dim, k, low = d < BLOCK_BITS ? d : BLOCK_BITS;
-    unsigned children = 1u << low, b;
-    double lo[VPDS_MAX_DIM], mid[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], sums[BLOCK_CHILDREN];
+    double lo[VPDS_MAX_DIM], mid[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
     uint64_t cc[VPDS_MAX_DIM] = {0};
     size_t j;
     for (k = 0; k < d; k++) cc[k] = 2 * c[k];
     vpdsi_lattice_box(&m->run.geom, level + 1, cc, lo, mid);
     for (k = 0; k < d; k++) cc[k] = 2 * c[k] + 1;
     vpdsi_lattice_box(&m->run.geom, level + 1, cc, mid, hi);
+    if (pen) vpdsi_pencil_reset(pen, d, lo, hi);
     for (j = 0; j < m->n_cand; j++) {
         const double *x = st->x + (size_t)m->cand[j] * (size_t)d;
         double f = scale * vpdsi_rule_f(pb->rule, st->r[m->cand[j]], r_lo), f2 = f * f;
-        double far[VPDS_MAX_DIM][2], least = 0;
+        double far[VPDS_MAX_DIM][2], least = 0, whole = 0, near2 = 0;
         if (!(f > 0)) continue;
         for (k = 0; k < d; k++) {
             double a = vpdsi_axis_far(x[k], lo[k], mid[k], pb->period[k]);
@@ -468,18 +556,18 @@ static void children_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned 
             far[k][0] = a * a;
             far[k][1] = z * z;
             least += far[k][0] < far[k][1] ? far[k][0] : far[k][1];
+            if (pen) {
+                double g = vpdsi_axis_gap(x[k], lo[k], hi[k], pb->period[k]);
+                near2 += g * g;
+                whole += far[k][0] > far[k][1] ? far[k][0] : far[k][1];
+            }
         }
+        if (pen && near2 < f2 && whole > f2) vpdsi_pencil_offer(pen, d, x, f2, whole, lo, hi, pb->period);
         if (least > f2) continue; /* covers no child */
-        sums[0] = 0;
-        for (k = 0; k < d; k++) sums[0] += far[k][k < low ? 0 : (block >> (k - low)) & 1u];
-        if (sums[0] <= f2) covered[0] |= 1u;
-        for (b = 1; b < children; b++) {
-            unsigned bit = 0;
-            while (!((b >> bit) & 1u)) bit++;
-            sums[b] = sums[b & (b - 1)] - far[bit][0] + far[bit][1];
-            if (sums[b] <= f2) covered[b >> 6] |= UINT64_C(1) << (b & 63u);
-        }
+        disk_children(d, low, block, (const double (*)[2])far, f2, covered);
     }
+    if (pen && pen->n >= 2 && !children_all_set(covered, 1u << low))
+        pencil_children(pen, d, low, block, lo, mid, hi, covered);
 }
 
 /* The background grid's cells (one radius, open axes, up to 8D: one block): in one pass over
@@ -491,8 +579,8 @@ static void children_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned 
 static int packed_cover(const vpdsi_mps *m, int d, unsigned level, const uint64_t *c, double f,
                         uint64_t *covered)
 {
-    unsigned children = 1u << d, b;
-    double lo[VPDS_MAX_DIM], mid[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], sums[BLOCK_CHILDREN], f2 = f * f;
+    unsigned children = 1u << d;
+    double lo[VPDS_MAX_DIM], mid[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], f2 = f * f;
     uint64_t cc[VPDS_MAX_DIM] = {0};
     size_t j;
     int k;
@@ -514,15 +602,7 @@ static int packed_cover(const vpdsi_mps *m, int d, unsigned level, const uint64_
         }
         if (whole <= f2) return 1;
         if (least > f2) continue; /* covers no child */
-        sums[0] = 0;
-        for (k = 0; k < d; k++) sums[0] += far[k][0];
-        if (sums[0] <= f2) covered[0] |= 1u;
-        for (b = 1; b < children; b++) {
-            unsigned bit = 0;
-            while (!((b >> bit) & 1u)) bit++;
-            sums[b] = sums[b & (b - 1)] - far[bit][0] + far[bit][1];
-            if (sums[b] <= f2) covered[b >> 6] |= UINT64_C(1) << (b & 63u);
-        }
+        disk_children(d, d, 0, (const double (*)[2])far, f2, covered);
         if (children_all_set(covered, children)) break;
     }
     return 0;
@@ -777,7 +857,7 @@ static vpds_status flag_uncovered(vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned l
     if (whole_c || parent == VPDSI_CELL_COVERED)
         cov_c[0] = cov_c[1] = cov_c[2] = cov_c[3] = ~UINT64_C(0);
     else if (split)
-        children_covered(m, ctx, level, c, r_lo, scale_c, block, cov_c);
+        children_covered(m, ctx, level, c, r_lo, scale_c, block, cov_c, NULL);
     for (b = 0; b < children; b++) {
         double clo[VPDS_MAX_DIM], chi[VPDS_MAX_DIM];
         int found = 0;
@@ -819,9 +899,10 @@ static vpds_status sweep_block(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_
     double scale = run->t * pb->inhibition;
     uint64_t covered[4] = {0, 0, 0, 0}, cc[VPDS_MAX_DIM];
     uint8_t flag[BLOCK_CHILDREN]; /* two radii: the child may hold an uncovered point */
+    vpdsi_pencil pen;
     vpds_status e;
     if (known) memcpy(covered, known, sizeof covered);
-    else if (split) children_covered(m, ctx, level, c, r_lo, scale, block, covered);
+    else if (split) children_covered(m, ctx, level, c, r_lo, scale, block, covered, uses_pencil(ctx) ? &pen : NULL);
     if (ctx->dom->fn && phi > -0.5 * h &&
         (e = drop_outside_children(m, ctx, level, c, split, block, centre, phi, covered)) != VPDS_OK)
         return e;
@@ -871,6 +952,8 @@ static vpds_status sweep_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t
     if (st->grid_mode && split) { /* one radius, open axes, one block: one pass decides all */
         if (packed_cover(m, d, level, c, scale * st->sizing.radius, known)) return VPDS_OK;
         pre = known;
+    } else if (uses_pencil(ctx)) {
+        if (box_held(m, ctx, lo, hi, r_lo, scale)) return VPDS_OK;
     } else if ((holder = box_holder(m, ctx, lo, hi, r_lo, scale)) >= 0) {
         m->holder = holder;
         return VPDS_OK;

@@ -225,9 +225,10 @@ def test_algorithm_version_pins_the_points():
     search test a splitting box's far corner (the points of 7); version 9 made the stream exact
     in 5D and 6D (2D streams and every run keep the points of 8); version 10 finds the 2D
     stream's farthest point from the Voronoi diagram (the same largest gaps, other bits; every
-    run keeps its points); version 11 does the same in 3D; a version the library does not have
-    is refused."""
-    assert vpds.ALGORITHM_VERSION == 11
+    run keeps its points); version 11 does the same in 3D; version 12 drops the cells two disks
+    hold together from 6D on (other points there, the same below); a version the library does
+    not have is refused."""
+    assert vpds.ALGORITHM_VERSION == 12
 
     def fill(version, inhibition):
         engine = vpds.PoissonDisk(2, sizing=lambda x: 0.04 + 0.04 * x[:, 0], lipschitz=0.04,
@@ -244,6 +245,7 @@ def test_algorithm_version_pins_the_points():
     assert np.array_equal(current, fill(9, 0.6))
     assert np.array_equal(current, fill(10, 0.6))
     assert np.array_equal(current, fill(11, 0.6))
+    assert np.array_equal(current, fill(12, 0.6))
     assert np.array_equal(current, v3)
     assert np.array_equal(v2, v3)
     assert not np.array_equal(v1, v2)
@@ -286,6 +288,16 @@ def test_algorithm_version_pins_the_points():
     assert np.array_equal(stream3(None), stream3(11))
     assert not np.array_equal(stream3(11), stream3(10))
     assert not np.array_equal(stream5(9), stream5(8))
-    for bad in (12, -1, 1.5, True):
-        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.11"):
+    assert np.array_equal(stream3(12), stream3(11))
+
+    def fill6(version):
+        return vpds.PoissonDisk(6, sizing=0.6, seed=3, progress=False,
+                                algorithm_version=version).fill_space()
+
+    # 6D: version 12's sweep drops the cells two disks hold together (other points)
+    assert np.array_equal(fill6(None), fill6(12))
+    assert not np.array_equal(fill6(12), fill6(11))
+    assert np.array_equal(fill6(11), fill6(10))
+    for bad in (13, -1, 1.5, True):
+        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.12"):
             vpds.PoissonDisk(2, algorithm_version=bad)
