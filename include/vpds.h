@@ -81,7 +81,9 @@ extern "C" {
  * of Algorithm 1 also drops a cell that two disks hold together though neither holds it alone
  * (the ball of their pencil centred on their radical hyperplane, which lies in their union),
  * so fewer cells split into 2^d children and fewer darts land where nothing is left (other
- * points for a run or refinement in 6D and up; everything else gives the points of 11). */
+ * points for a run or refinement in 6D and up), and up to 5D the coverage search of two radii
+ * and of a domain drops such a box too (the points of 11 except where the search's box budget
+ * decided; everything else gives the points of 11). */
 #define VPDS_ALGORITHM_VERSION 12
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 16
