@@ -1,7 +1,7 @@
 /* Branch-and-bound over boxes of the region's bounding box: a box is dropped when it misses
- * the region, lies outside the domain or inside one sample's coverage disk; a box point inside
- * the region and the domain and outside every coverage disk is an uncovered witness; anything
- * else splits into 2^d. Boxes live in coordinates around the anchor; on a periodic axis the
+ * the region, lies outside the domain or inside one sample's coverage disk (version 12, up to
+ * 5D: or two samples' together, pencil.h); a box point inside the region and the domain and
+ * outside every coverage disk is an uncovered witness; anything else splits into 2^d. Boxes live in coordinates around the anchor; on a periodic axis the
  * kd-tree wraps them. The search reads candidate lists handed down from box to sub-box. */
 #include "uncovered.h"
 #include "pencil.h"
@@ -50,7 +50,8 @@ typedef struct {
     double *witness;  /* where the uncovered point found goes (dim coordinates, then r there) */
     int found_point;  /* *found came from such a point, not from the budget or the precision */
     int drop_kept;    /* the box examined last was dropped for good: inside one coverage disk
-                         or outside the domain (not for missing this question's region) */
+                         (or two, version 12), or outside the domain (not for missing this
+                         question's region) */
     uint64_t *sub;    /* version 6: the cell's sub-boxes shown covered, as this search goes */
     uint64_t sub_now; /* where sub points: written back only when the search ends without an
                          error, so that a retried dart takes the same boxes as the first try */
@@ -233,7 +234,8 @@ static int pencil_covers(const bb_search *q, const int32_t *cand, size_t n, cons
     return 0;
 }
 
-/* Whether one sample covers the whole box, r_lo <= r <= r_hi over it (gather, then the test). */
+/* Whether one sample covers the whole box, r_lo <= r <= r_hi over it (gather, then the test),
+ * or (version 12, up to 5D) two together (pencil_covers). */
 static vpds_status search_box_covered(bb_search *q, int depth, const double *lo, const double *hi,
                                double r_lo, double r_hi, int *covered)
 {
@@ -256,8 +258,17 @@ static vpds_status search_box_covered(bb_search *q, int depth, const double *lo,
     *covered = r_lo > 0 && vpdsi_kd_box_covered(&q->st->tree, &q->view, q->u->lists + off,
                                                 q->u->n_lists - off, lo, hi, r_lo, (int)q->pb->rule,
                                                 q->scale);
-    if (!*covered && q->pencil && r_lo > 0 && q->u->n_lists - off > 1)
+    if (!*covered && q->pencil && r_lo > 0) {
+        /* the gather keeps only disks that may hold the whole box: the pencil reads every disk
+         * that reaches into it, as the lists hold them, so that both ways answer alike */
+        q->u->n_lists = off;
+        if (vpdsi_kd_near_box(&q->st->tree, &q->view, lo, hi, r_hi, q->scale, q->slack, SIZE_MAX, q->st->mem,
+                              &q->u->lists, &q->u->n_lists, &q->u->cap_lists) < 0) {
+            vpdsi_store_error(q->st, "out of memory listing the samples near a box");
+            return VPDS_ERR_OUT_OF_MEMORY;
+        }
         *covered = pencil_covers(q, q->u->lists + off, q->u->n_lists - off, lo, hi, r_lo);
+    }
     return VPDS_OK;
 }
 
@@ -389,7 +400,7 @@ static vpds_status examine(bb_search *q, const double *lo, const double *hi, int
         if ((st = take_witness(q, p, q->rp, verdict)) != VPDS_OK || *verdict) return st;
     }
     if ((st = search_box_covered(q, depth, lo, hi, r_lo, r_hi, verdict)) != VPDS_OK) return st;
-    if (*verdict) { /* inside one coverage disk */
+    if (*verdict) { /* inside one coverage disk, or two */
         *verdict = 0;
         q->drop_kept = 1;
         return VPDS_OK;

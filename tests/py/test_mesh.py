@@ -184,8 +184,10 @@ def test_algorithm_version_pins_the_mesh_stream():
                                   current.points)
     np.testing.assert_array_equal(vpds.sample_mesh(m, radius=0.2, n=80, rng=3, algorithm_version=9).points,
                                   current.points)
-    for bad in (2, 12, -1, 1.5, True):
-        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 3\.\.11"):
+    np.testing.assert_array_equal(vpds.sample_mesh(m, radius=0.2, n=80, rng=3, algorithm_version=12).points,
+                                  current.points)
+    for bad in (2, 13, -1, 1.5, True):
+        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 3\.\.12"):
             vpds.sample_mesh(m, algorithm_version=bad)
 
 
