@@ -406,35 +406,16 @@ static int box_held(const vpdsi_mps *m, const vpdsi_ctx *ctx, const double *lo, 
 {
     const vpdsi_problem *pb = ctx->pb;
     const vpdsi_store *st = ctx->st;
-    int d = pb->dim, k, pair;
     vpdsi_pencil pen;
     size_t j;
-    vpdsi_pencil_reset(&pen, d, lo, hi);
+    vpdsi_pencil_reset(&pen, pb->dim, lo, hi);
     for (j = 0; j < m->n_cand; j++) {
-        const double *x = st->x + (size_t)m->cand[j] * (size_t)d;
-        double f = scale * vpdsi_rule_f(pb->rule, st->r[m->cand[j]], r_lo), far2 = 0, near2 = 0;
-        if (!(f > 0)) continue;
-        for (k = 0; k < d; k++) {
-            double e = vpdsi_axis_far(x[k], lo[k], hi[k], pb->period[k]);
-            far2 += e * e;
-        }
-        if (far2 <= f * f) return 1; /* box_maxdist2's sum, as covers_box takes it */
-        for (k = 0; k < d; k++) {
-            double g = vpdsi_axis_gap(x[k], lo[k], hi[k], pb->period[k]);
-            near2 += g * g;
-        }
-        if (near2 < f * f) vpdsi_pencil_offer(&pen, d, x, f * f, far2, lo, hi, pb->period);
+        double f = scale * vpdsi_rule_f(pb->rule, st->r[m->cand[j]], r_lo);
+        if (f > 0 && vpdsi_pencil_take(&pen, pb->dim, st->x + (size_t)m->cand[j] * (size_t)pb->dim, f * f, lo, hi,
+                                       pb->period))
+            return 1;
     }
-    for (pair = 0; pair < VPDSI_PENCIL_PAIRS; pair++) {
-        double y[VPDS_MAX_DIM], r2, far2 = 0;
-        if (!vpdsi_pencil_ball(&pen, d, pair, y, &r2)) continue;
-        for (k = 0; k < d; k++) {
-            double e = vpdsi_axis_far(y[k], lo[k], hi[k], 0.0);
-            far2 += e * e;
-        }
-        if (far2 <= r2) return 1;
-    }
-    return 0;
+    return vpdsi_pencil_holds(&pen, pb->dim, lo, hi);
 }
 
 /* The candidate that holds the box [lo, hi] whole, or -1. */

@@ -1,5 +1,6 @@
 /* The ball two disks hold together (pencil.h). */
 #include "pencil.h"
+#include "torus.h"
 #include <float.h>
 #include <math.h>
 #include <string.h>
@@ -68,4 +69,37 @@ int vpdsi_pencil_ball(const vpdsi_pencil *p, int d, int pair, double *y, double 
     for (k = 0; k < d; k++) y[k] = th * p->x[i][k] + (1 - th) * p->x[j][k];
     *r2 = rho * rho;
     return 1;
+}
+
+int vpdsi_pencil_take(vpdsi_pencil *p, int d, const double *x, double f2, const double *lo,
+                      const double *hi, const double *period)
+{
+    double far2 = 0, near2 = 0;
+    int k;
+    for (k = 0; k < d; k++) {
+        double e = vpdsi_axis_far(x[k], lo[k], hi[k], period[k]);
+        far2 += e * e;
+    }
+    if (far2 <= f2) return 1;
+    for (k = 0; k < d; k++) {
+        double g = vpdsi_axis_gap(x[k], lo[k], hi[k], period[k]);
+        near2 += g * g;
+    }
+    if (near2 < f2) vpdsi_pencil_offer(p, d, x, f2, far2, lo, hi, period);
+    return 0;
+}
+
+int vpdsi_pencil_holds(const vpdsi_pencil *p, int d, const double *lo, const double *hi)
+{
+    int pair, k;
+    for (pair = 0; pair < VPDSI_PENCIL_PAIRS; pair++) {
+        double y[VPDS_MAX_DIM], r2, far2 = 0;
+        if (!vpdsi_pencil_ball(p, d, pair, y, &r2)) continue;
+        for (k = 0; k < d; k++) {
+            double e = vpdsi_axis_far(y[k], lo[k], hi[k], 0.0);
+            far2 += e * e;
+        }
+        if (far2 <= r2) return 1;
+    }
+    return 0;
 }

@@ -206,32 +206,16 @@ static int32_t p_cover(bb_search *q, int depth, const double *p, double rp)
 static int pencil_covers(const bb_search *q, const int32_t *cand, size_t n, const double *lo,
                          const double *hi, double r_lo)
 {
-    int d = q->pb->dim, k, pair;
-    const double *period = q->pb->period;
+    int d = q->pb->dim;
     vpdsi_pencil pen;
     size_t j;
     vpdsi_pencil_reset(&pen, d, lo, hi);
     for (j = 0; j < n; j++) {
-        const double *x = q->view.x + (size_t)cand[j] * (size_t)d;
-        double f = q->scale * vpdsi_rule_f(q->pb->rule, q->view.r[cand[j]], r_lo), far2 = 0, near2 = 0;
-        if (!(f > 0)) continue;
-        for (k = 0; k < d; k++) {
-            double e = vpdsi_axis_far(x[k], lo[k], hi[k], period[k]), g = vpdsi_axis_gap(x[k], lo[k], hi[k], period[k]);
-            far2 += e * e;
-            near2 += g * g;
-        }
-        if (near2 < f * f && far2 > f * f) vpdsi_pencil_offer(&pen, d, x, f * f, far2, lo, hi, period);
+        double f = q->scale * vpdsi_rule_f(q->pb->rule, q->view.r[cand[j]], r_lo);
+        if (f > 0 && vpdsi_pencil_take(&pen, d, q->view.x + (size_t)cand[j] * (size_t)d, f * f, lo, hi, q->pb->period))
+            return 1; /* one disk holds it (box_covered found none: not reached) */
     }
-    for (pair = 0; pair < VPDSI_PENCIL_PAIRS; pair++) {
-        double y[VPDS_MAX_DIM], r2, far2 = 0;
-        if (!vpdsi_pencil_ball(&pen, d, pair, y, &r2)) continue;
-        for (k = 0; k < d; k++) {
-            double e = vpdsi_axis_far(y[k], lo[k], hi[k], 0.0);
-            far2 += e * e;
-        }
-        if (far2 <= r2) return 1;
-    }
-    return 0;
+    return vpdsi_pencil_holds(&pen, d, lo, hi);
 }
 
 /* Whether one sample covers the whole box, r_lo <= r <= r_hi over it (gather, then the test),
