@@ -177,17 +177,8 @@ static double ratio(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i,
 static int covers_box(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, int32_t i, const double *lo,
                       const double *hi, double r_lo, int rule, double scale)
 {
-    const double *x = s->x + (size_t)i * (size_t)t->dim;
-    double f = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_lo), f2 = f * f, far2 = 0;
-    int k;
-    if (!(f > 0)) return 0;
-    /* vpdsi_box_maxdist2 <= f2, stopping once the sum (which only grows) is past it */
-    for (k = 0; k < t->dim; k++) {
-        double e = vpdsi_axis_far(x[k], lo[k], hi[k], t->period[k]);
-        far2 += e * e;
-        if (far2 > f2) return 0;
-    }
-    return 1;
+    double f = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_lo);
+    return f > 0 && vpdsi_box_maxdist2(t, s->x + (size_t)i * (size_t)t->dim, lo, hi) <= f * f;
 }
 
 int32_t vpdsi_kd_conflict(const vpdsi_kdtree *t, const vpdsi_kd_samples *s, const double *y,

@@ -530,8 +530,7 @@ static void children_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned 
         const double *x = st->x + (size_t)m->cand[j] * (size_t)d;
         double f = scale * vpdsi_rule_f(pb->rule, st->r[m->cand[j]], r_lo), f2 = f * f;
         double far[VPDS_MAX_DIM][2], least = 0, whole = 0, near2 = 0;
-        /* a disk that does not reach into the cell covers no child and joins no pencil */
-        if (!(f > 0) || vpdsi_box_beyond(d, x, lo, hi, pb->period, f2)) continue;
+        if (!(f > 0)) continue;
         for (k = 0; k < d; k++) {
             double a = vpdsi_axis_far(x[k], lo[k], mid[k], pb->period[k]);
             double z = vpdsi_axis_far(x[k], mid[k], hi[k], pb->period[k]);
@@ -561,7 +560,6 @@ static void children_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned 
 static int packed_cover(const vpdsi_mps *m, int d, unsigned level, const uint64_t *c, double f,
                         uint64_t *covered)
 {
-    static const double open_axes[VPDS_MAX_DIM] = {0}; /* the grid's axes are open */
     unsigned children = 1u << d;
     double lo[VPDS_MAX_DIM], mid[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], f2 = f * f;
     uint64_t cc[VPDS_MAX_DIM] = {0};
@@ -575,7 +573,6 @@ static int packed_cover(const vpdsi_mps *m, int d, unsigned level, const uint64_
     for (j = 0; j < m->n_cand; j++) {
         const double *x = m->cand_x + j * (size_t)d;
         double far[VPDS_MAX_DIM][2], least = 0, whole = 0;
-        if (vpdsi_box_beyond(d, x, lo, hi, open_axes, f2)) continue; /* holds no part */
         for (k = 0; k < d; k++) {
             double a = vpdsi_axis_far(x[k], lo[k], mid[k], 0.0);
             double z = vpdsi_axis_far(x[k], mid[k], hi[k], 0.0);

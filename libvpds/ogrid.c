@@ -32,8 +32,6 @@ int vpdsi_ogrid_setup(vpdsi_ogrid *g, int dim, const double *lo, const double *h
         g->lv[l].inv = 1 / side;
     }
     g->levels = l;
-    g->filled_lo = l;
-    g->filled_hi = -1;
     return 0;
 }
 
@@ -117,8 +115,6 @@ void vpdsi_ogrid_insert(vpdsi_ogrid *g, const vpdsi_kd_samples *s, int32_t i)
     }
     if (lv->count == 0 || s->r[i] > lv->rmax) lv->rmax = s->r[i];
     lv->count++;
-    if (l < g->filled_lo) g->filled_lo = l;
-    if (l > g->filled_hi) g->filled_hi = l;
     j = slot_of(g, key_of(l, c, g->dim));
     if (g->slots[j].key == 0) {
         g->slots[j].key = key_of(l, c, g->dim);
@@ -298,10 +294,8 @@ int32_t vpdsi_ogrid_conflict(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, co
                              int32_t *witness)
 {
     int home = level_of(g, ry), step, k;
-    int span = home - g->filled_lo > g->filled_hi - home ? home - g->filled_lo : g->filled_hi - home;
-    /* the level of ry first, then outwards to the last level that holds samples: conflicts
-     * are likeliest among similar radii */
-    for (step = 0; step <= 2 * span; step++) {
+    /* the level of ry first, then outwards: conflicts are likeliest among similar radii */
+    for (step = 0; step < 2 * g->levels; step++) {
         int l = home + (step % 2 ? (step + 1) / 2 : -(step / 2));
         uint64_t a[3], b[3], c[3], yc[3];
         size_t pos = 0;
@@ -332,7 +326,7 @@ int vpdsi_ogrid_gather(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const do
     double c0[3], c1[3], w[3];
     int l;
     vpdsi_prox_gather_centres(g->dim, lo, hi, split, c0, c1, w);
-    for (l = g->filled_lo; l <= g->filled_hi; l++) {
+    for (l = 0; l < g->levels; l++) {
         uint64_t a[3], b[3], c[3];
         size_t pos = 0;
         int32_t i;
@@ -370,7 +364,7 @@ int vpdsi_ogrid_near_box(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const 
                          int32_t **out, size_t *count, size_t *cap)
 {
     int l;
-    for (l = g->filled_lo; l <= g->filled_hi; l++) {
+    for (l = 0; l < g->levels; l++) {
         uint64_t a[3], b[3], c[3];
         size_t pos = 0;
         int32_t i;

@@ -28,7 +28,6 @@ typedef struct vpdsi_ogrid_slot {
 
 typedef struct vpdsi_ogrid {
     int dim, levels;               /* levels in use: side >= the box extent / 2^BITS */
-    int filled_lo, filled_hi;      /* the lowest and highest level holding a sample (hi -1: none) */
     double lo[3];
     vpdsi_ogrid_level lv[VPDSI_OGRID_LEVELS];
     vpdsi_ogrid_slot *slots;

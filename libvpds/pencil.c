@@ -76,8 +76,6 @@ int vpdsi_pencil_take(vpdsi_pencil *p, int d, const double *x, double f2, const 
 {
     double far2 = 0, near2 = 0;
     int k;
-    /* most disks of a list do not reach a small box: neither held nor offered */
-    if (vpdsi_box_beyond(d, x, lo, hi, period, f2)) return 0;
     for (k = 0; k < d; k++) {
         double e = vpdsi_axis_far(x[k], lo[k], hi[k], period[k]);
         far2 += e * e;

@@ -5,10 +5,9 @@
  * coordinates in the marks beside it. */
 #ifndef VPDS_SURFACE_H
 #define VPDS_SURFACE_H
+#define VPDSI_RECENT_COVERS 4
 #include "piece_array.h"
 #include "rng.h"
-
-#define VPDSI_RECENT_COVERS 4 /* disks that held the last pieces, tried before a piece's list */
 
 typedef enum {
     VPDSI_SURF_IDLE, VPDSI_SURF_SEED, VPDSI_SURF_FILTER, VPDSI_SURF_DARTS, VPDSI_SURF_SWEEP,

@@ -31,23 +31,6 @@ static inline double vpdsi_axis_gap(double p, double lo, double hi, double P)
     return best;
 }
 
-/* Whether the squared distance from p to the box [lo, hi] exceeds f2 (summed axis by axis,
- * stopping once past it). Each axis's gap is at most its farthest distance to the box or to
- * any part of it, term by term and so in every sum of them: a disk that fails this holds no
- * part of the box, nor reaches into it. */
-static inline int vpdsi_box_beyond(int d, const double *p, const double *lo, const double *hi,
-                                   const double *period, double f2)
-{
-    double near2 = 0;
-    int k;
-    for (k = 0; k < d; k++) {
-        double g = vpdsi_axis_gap(p[k], lo[k], hi[k], period[k]);
-        near2 += g * g;
-        if (near2 > f2) return 1;
-    }
-    return 0;
-}
-
 /* Farthest distance from p to [lo, hi], for the one image of p that makes it smallest: a box
  * is inside a disk of one image when this summed over axes is within the radius. */
 static inline double vpdsi_axis_far(double p, double lo, double hi, double P)

@@ -6,7 +6,6 @@
 #include "check.h"
 #include "vpds.h"
 #include "pencil.h"
-#include "torus.h"
 #include <math.h>
 #include <string.h>
 
@@ -137,51 +136,6 @@ static void check_offers(void)
     CHECK(fabs(pen.x[1][0] - (0.95 - 0.01 - 1)) < 1e-12);
 }
 
-/* vpdsi_box_beyond, the early exit of the sweep's per-disk tests (pencil_take, and the
- * children's and the grid's passes in mps.c): it says beyond exactly when the whole sum of the
- * axis gaps is past f2 (f2 drawn at, just below and just above that sum, and anywhere), and
- * then the farthest distance to the box and to each of its halves is past f2 too, so a disk it
- * skips holds no part of the box. Periodic axes on one try in three. */
-static void check_box_beyond(void)
-{
-    int d, t, k, wrong = 0, unsafe = 0, tries = 0, beyond = 0;
-    for (d = 1; d <= VPDS_MAX_DIM; d++)
-        for (t = 0; t < 400; t++) {
-            double lo[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], mid[VPDS_MAX_DIM], x[VPDS_MAX_DIM];
-            double period[VPDS_MAX_DIM], near2 = 0, far2 = 0, lo2 = 0, hi2 = 0, f2;
-            int pick = t % 4;
-            for (k = 0; k < d; k++) {
-                double w = ldexp(unit(), -(int)(unit() * 20)) + 1e-300;
-                period[k] = t % 3 == 0 && k % 2 == 0 ? 1.0 : 0.0;
-                lo[k] = unit() * (1 - w);
-                hi[k] = lo[k] + w;
-                mid[k] = 0.5 * (lo[k] + hi[k]);
-                x[k] = (t % 5 == 0 ? 0.5 : 3.0) * (unit() - 0.25);
-            }
-            for (k = 0; k < d; k++) {
-                double g = vpdsi_axis_gap(x[k], lo[k], hi[k], period[k]);
-                double a = vpdsi_axis_far(x[k], lo[k], hi[k], period[k]);
-                double b = vpdsi_axis_far(x[k], lo[k], mid[k], period[k]);
-                double c = vpdsi_axis_far(x[k], mid[k], hi[k], period[k]);
-                near2 += g * g;
-                far2 += a * a;
-                lo2 += b * b;
-                hi2 += c * c;
-            }
-            f2 = pick == 0 ? near2 : pick == 1 ? nextafter(near2, 0) : pick == 2 ? nextafter(near2, INFINITY)
-                                                                                  : unit() * 3 * d;
-            tries++;
-            if (vpdsi_box_beyond(d, x, lo, hi, period, f2) != (near2 > f2)) wrong++;
-            if (vpdsi_box_beyond(d, x, lo, hi, period, f2)) {
-                beyond++;
-                if (!(far2 > f2 && lo2 > f2 && hi2 > f2)) unsafe++;
-            }
-        }
-    CHECK_MSG(wrong == 0, "vpdsi_box_beyond disagrees with the whole sum on %d of %d tries", wrong, tries);
-    CHECK_MSG(unsafe == 0, "%d of %d boxes called beyond are within reach of their farthest point", unsafe, beyond);
-    CHECK(beyond > tries / 4 && beyond < tries); /* both answers met */
-}
-
 int main(void)
 {
     long claimed = 0, outside = 0;
@@ -191,6 +145,5 @@ int main(void)
     CHECK_MSG(outside == 0, "%ld of %ld points of the balls outside both disks", outside, claimed);
     check_straddling_box();
     check_offers();
-    check_box_beyond();
     CHECK_DONE();
 }
