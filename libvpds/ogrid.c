@@ -37,40 +37,53 @@ int vpdsi_ogrid_setup(vpdsi_ogrid *g, int dim, const double *lo, const double *h
 
 void vpdsi_ogrid_release(vpdsi_ogrid *g, vpdsi_mem *m)
 {
-    vpdsi_mem_free(m, g->slots, g->cap * sizeof *g->slots);
+    vpdsi_mem_free(m, g->keys, g->cap * sizeof *g->keys);
+    vpdsi_mem_free(m, g->heads, g->cap * sizeof *g->heads);
     vpdsi_mem_free(m, g->next, g->cap_next * sizeof *g->next);
-    g->slots = NULL;
-    g->next = NULL;
+    g->keys = NULL;
+    g->heads = g->next = NULL;
     g->cap = g->used = g->cap_next = 0;
 }
 
 static size_t slot_of(const vpdsi_ogrid *g, uint64_t key)
 {
     size_t mask = g->cap - 1, i = (size_t)vpdsi_mix64(key) & mask;
-    while (g->slots[i].key != 0 && g->slots[i].key != key) i = (i + 1) & mask;
+    while (g->keys[i] != 0 && g->keys[i] != key) i = (i + 1) & mask;
     return i;
 }
 
 int vpdsi_ogrid_reserve(vpdsi_ogrid *g, vpdsi_mem *m, size_t n_total, size_t more)
 {
     size_t cap = g->cap ? g->cap : 64, i;
-    vpdsi_ogrid_slot *slots;
+    uint64_t *keys;
+    int32_t *heads;
     if (vpdsi_mem_reserve(m, (void **)&g->next, &g->cap_next, n_total, sizeof *g->next)) return -1;
     while (cap / 2 < g->used + more) {
-        if (cap > ((size_t)-1) / 4 / sizeof *slots) return -1;
+        if (cap > ((size_t)-1) / 4 / sizeof *keys) return -1;
         cap *= 2;
     }
     if (cap == g->cap) return 0;
-    slots = (vpdsi_ogrid_slot *)vpdsi_mem_alloc(m, cap * sizeof *slots);
-    if (!slots) return -1;
-    memset(slots, 0, cap * sizeof *slots);
+    keys = (uint64_t *)vpdsi_mem_alloc(m, cap * sizeof *keys);
+    heads = (int32_t *)vpdsi_mem_alloc(m, cap * sizeof *heads);
+    if (!keys || !heads) {
+        if (keys) vpdsi_mem_free(m, keys, cap * sizeof *keys);
+        if (heads) vpdsi_mem_free(m, heads, cap * sizeof *heads);
+        return -1;
+    }
+    memset(keys, 0, cap * sizeof *keys);
     {
         vpdsi_ogrid old = *g;
-        g->slots = slots;
+        g->keys = keys;
+        g->heads = heads;
         g->cap = cap;
         for (i = 0; i < old.cap; i++)
-            if (old.slots[i].key) slots[slot_of(g, old.slots[i].key)] = old.slots[i];
-        vpdsi_mem_free(m, old.slots, old.cap * sizeof *old.slots);
+            if (old.keys[i]) {
+                size_t j = slot_of(g, old.keys[i]);
+                keys[j] = old.keys[i];
+                heads[j] = old.heads[i];
+            }
+        vpdsi_mem_free(m, old.keys, old.cap * sizeof *old.keys);
+        vpdsi_mem_free(m, old.heads, old.cap * sizeof *old.heads);
     }
     return 0;
 }
@@ -116,14 +129,14 @@ void vpdsi_ogrid_insert(vpdsi_ogrid *g, const vpdsi_kd_samples *s, int32_t i)
     if (lv->count == 0 || s->r[i] > lv->rmax) lv->rmax = s->r[i];
     lv->count++;
     j = slot_of(g, key_of(l, c, g->dim));
-    if (g->slots[j].key == 0) {
-        g->slots[j].key = key_of(l, c, g->dim);
+    if (g->keys[j] == 0) {
+        g->keys[j] = key_of(l, c, g->dim);
         g->next[i] = -1;
         g->used++;
     } else {
-        g->next[i] = g->slots[j].head;
+        g->next[i] = g->heads[j];
     }
-    g->slots[j].head = i;
+    g->heads[j] = i;
 }
 
 /* Squared gap between the boxes [alo, ahi] and [blo, bhi]. */
@@ -201,9 +214,9 @@ static double range_cells(int dim, const uint64_t *a, const uint64_t *b)
 static int slot_in_range(const vpdsi_ogrid *g, size_t j, int l, const uint64_t *a,
                          const uint64_t *b, uint64_t *c)
 {
-    uint64_t key = g->slots[j].key - 1;
+    uint64_t key = g->keys[j] - 1;
     int k;
-    if (g->slots[j].key == 0 || (int)(key >> (3 * VPDSI_OGRID_BITS)) != l) return 0;
+    if (g->keys[j] == 0 || (int)(key >> (3 * VPDSI_OGRID_BITS)) != l) return 0;
     for (k = 0; k < g->dim; k++) {
         c[k] = (key >> (k * VPDSI_OGRID_BITS)) & CELL_MAX;
         if (c[k] < a[k] || c[k] > b[k]) return 0;
@@ -216,34 +229,31 @@ static int32_t head_of(const vpdsi_ogrid *g, int l, const uint64_t *c)
     size_t j;
     if (g->cap == 0) return -1;
     j = slot_of(g, key_of(l, c, g->dim));
-    return g->slots[j].key ? g->slots[j].head : -1;
+    return g->keys[j] ? g->heads[j] : -1;
 }
 
-/* The cells of level l to read for the range [a, b] that lie within reach of the box
- * [lo, hi] (cell_beyond, tested before the table is read): the range itself, or, when it has
- * more cells than the table has slots (a reach far above the level's radii), the table's cells
- * of that level within it (scan_table, from range_cells): at most as many reads as the table
- * has slots. Returns the next cell's first sample through *head (-1 at a cell without
- * samples), 0 past the last cell. *pos is the iteration state, 0 at the start. */
+/* The cells of level l to read for the range [a, b]: the range itself, or, when it has more
+ * cells than the table has slots (a reach far above the level's radii), the table's cells of
+ * that level within it (scan_table, from range_cells): at most as many reads as the table has
+ * slots. Returns the next cell's
+ * first sample through *head (-1 at a cell without samples), 0 past the last cell. *pos is the
+ * iteration state, 0 at the start. */
 static int next_range_cell(const vpdsi_ogrid *g, int l, const uint64_t *a, const uint64_t *b,
-                           int scan_table, const double *lo, const double *hi, double reach,
-                           uint64_t *c, size_t *pos, int32_t *head)
+                           int scan_table, uint64_t *c, size_t *pos, int32_t *head)
 {
     if (scan_table) {
         while (*pos < g->cap) {
             size_t j = (*pos)++;
-            if (slot_in_range(g, j, l, a, b, c) && !cell_beyond(g, l, c, lo, hi, reach)) {
-                *head = g->slots[j].head;
+            if (slot_in_range(g, j, l, a, b, c)) {
+                *head = g->heads[j];
                 return 1;
             }
         }
         return 0;
     }
-    do {
-        if (*pos == 0) memcpy(c, a, (size_t)g->dim * sizeof *c);
-        else if (!next_cell(g->dim, a, b, c)) return 0;
-        (*pos)++;
-    } while (cell_beyond(g, l, c, lo, hi, reach));
+    if (*pos == 0) memcpy(c, a, (size_t)g->dim * sizeof *c);
+    else if (!next_cell(g->dim, a, b, c)) return 0;
+    (*pos)++;
     *head = head_of(g, l, c);
     return 1;
 }
@@ -260,12 +270,13 @@ void vpdsi_ogrid_prefetch(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const
     key = key_of(l, c, g->dim);
     if (stage == 0) {
         j = (size_t)vpdsi_mix64(key) & (g->cap - 1);
-        VPDSI_PREFETCH(g->slots + j);
+        VPDSI_PREFETCH(g->keys + j);
+        VPDSI_PREFETCH(g->heads + j);
         return;
     }
     j = slot_of(g, key);
-    if (g->slots[j].key) {
-        int32_t i = g->slots[j].head;
+    if (g->keys[j]) {
+        int32_t i = g->heads[j];
         VPDSI_PREFETCH(s->x + (size_t)i * (size_t)g->dim);
         VPDSI_PREFETCH(s->r + i);
         VPDSI_PREFETCH(g->next + i);
@@ -311,8 +322,9 @@ int32_t vpdsi_ogrid_conflict(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, co
             (hit = chain_conflict(g, s, head_of(g, l, yc), y, ry, rule, scale, lipschitz, witness)) != -1)
             return hit;
         scan = range_cells(g->dim, a, b) > (double)g->cap;
-        while (next_range_cell(g, l, a, b, scan, y, y, reach, c, &pos, &i)) {
-            if (i < 0 || !memcmp(c, yc, (size_t)g->dim * sizeof *c)) continue;
+        while (next_range_cell(g, l, a, b, scan, c, &pos, &i)) {
+            if (i < 0 || !memcmp(c, yc, (size_t)g->dim * sizeof *c) || cell_beyond(g, l, c, y, y, reach))
+                continue;
             if ((hit = chain_conflict(g, s, i, y, ry, rule, scale, lipschitz, witness)) != -1) return hit;
         }
     }
@@ -337,8 +349,8 @@ int vpdsi_ogrid_gather(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const do
         /* a sample covers a sub-box only from within its reach of the box */
         if (!cell_range(g, l, lo, hi, reach, a, b)) continue;
         scan = range_cells(g->dim, a, b) > (double)g->cap;
-        while (next_range_cell(g, l, a, b, scan, lo, hi, reach, c, &pos, &i)) {
-            if (i < 0) continue;
+        while (next_range_cell(g, l, a, b, scan, c, &pos, &i)) {
+            if (i < 0 || cell_beyond(g, l, c, lo, hi, reach)) continue;
             for (; i >= 0; i = g->next[i]) {
                 if (!vpdsi_prox_may_cover(s, i, g->dim, open_axes, c0, c1, w, r_hi, rule, scale))
                     continue;
@@ -375,8 +387,8 @@ int vpdsi_ogrid_near_box(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const 
         reach = scale * (g->lv[l].rmax > r_bound ? g->lv[l].rmax : r_bound) * (1 + 1e-9);
         if (!cell_range(g, l, lo, hi, reach, a, b)) continue;
         scan = range_cells(g->dim, a, b) > (double)g->cap;
-        while (next_range_cell(g, l, a, b, scan, lo, hi, reach, c, &pos, &i)) {
-            if (i < 0) continue;
+        while (next_range_cell(g, l, a, b, scan, c, &pos, &i)) {
+            if (i < 0 || cell_beyond(g, l, c, lo, hi, reach)) continue;
             for (; i >= 0; i = g->next[i]) {
                 if (!vpdsi_prox_near(s, i, g->dim, open_axes, lo, hi, r_bound, scale, 0)) continue;
                 if (*count == *cap && vpdsi_mem_reserve(m, (void **)out, cap, *count + 1, sizeof **out))

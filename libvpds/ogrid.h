@@ -20,17 +20,12 @@ typedef struct vpdsi_ogrid_level {
     size_t count;
 } vpdsi_ogrid_level;
 
-/* A slot of the hash table: its cell's key and first sample side by side, one read. */
-typedef struct vpdsi_ogrid_slot {
-    uint64_t key;                  /* 0: empty slot; else 1 + (level, cell) */
-    int32_t head;                  /* first sample of the slot's cell */
-} vpdsi_ogrid_slot;
-
 typedef struct vpdsi_ogrid {
     int dim, levels;               /* levels in use: side >= the box extent / 2^BITS */
     double lo[3];
     vpdsi_ogrid_level lv[VPDSI_OGRID_LEVELS];
-    vpdsi_ogrid_slot *slots;
+    uint64_t *keys;                /* 0: empty slot; else 1 + (level, cell) */
+    int32_t *heads;                /* first sample of the slot's cell */
     size_t cap, used;              /* slots (a power of two), slots in use */
     int32_t *next;                 /* per sample: the next one of its cell, -1 at the end */
     size_t cap_next;

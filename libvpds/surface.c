@@ -108,11 +108,9 @@ static vpds_status piece_near(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, do
     if (!inside) {
         s->cache_ok = 0;
         s->n_cache = 0;
-        /* at least two disks wide: deep pieces come a few parents apart */
-        double margin = 2 * edge > 2 * scale * r_hi ? 2 * edge : 2 * scale * r_hi;
         for (k = 0; k < 3; k++) {
-            s->cache_lo[k] = lo[k] - margin;
-            s->cache_hi[k] = hi[k] + margin;
+            s->cache_lo[k] = lo[k] - 2 * edge;
+            s->cache_hi[k] = hi[k] + 2 * edge;
         }
         s->cache_r = ctx->mesh->vr || st->sizing.kind != VPDSI_SIZING_CONSTANT ? 1.25 * r_hi : r_hi;
         if ((e = vpdsi_store_near_box(st, s->cache_lo, s->cache_hi, s->cache_r, scale, &s->cache,
@@ -144,26 +142,6 @@ static int holds_corners(const vpdsi_surface *s, const vpdsi_surface_ctx *ctx, i
     return 1;
 }
 
-/* A sample that held a piece, tried first for the next pieces (neighbours are mostly held by
- * the disks that held the pieces just before them). */
-static void remember_cover(vpdsi_surface *s, int32_t i)
-{
-    unsigned k;
-    for (k = 0; k < VPDSI_RECENT_COVERS; k++)
-        if (s->recent[k] == i) return;
-    s->recent[s->recent_at] = i;
-    s->recent_at = (s->recent_at + 1) % VPDSI_RECENT_COVERS;
-}
-
-/* Whether one of the recent holders holds the piece. */
-static int recent_covers(const vpdsi_surface *s, const vpdsi_surface_ctx *ctx, double x[3][3], double r_lo)
-{
-    unsigned k;
-    for (k = 0; k < VPDSI_RECENT_COVERS; k++)
-        if (s->recent[k] >= 0 && holds_corners(s, ctx, s->recent[k], x, r_lo)) return 1;
-    return 0;
-}
-
 /* Whether one sample of the near list holds the piece; the one found is tried first for the
  * next piece (neighbours are mostly held by the same disk). */
 static int corners_covered(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, double x[3][3],
@@ -172,7 +150,7 @@ static int corners_covered(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, doubl
     size_t n;
     for (n = 0; n < s->n_near; n++)
         if (holds_corners(s, ctx, s->near[n], x, r_lo)) {
-            remember_cover(s, s->near[n]);
+            s->last_cover = s->near[n];
             return 1;
         }
     return 0;
@@ -247,8 +225,7 @@ static void begin_piece_sweep(vpdsi_surface *s, vpdsi_surf_phase phase)
     s->crow = s->cpos = 0;
     s->split_any = 0;
     s->cache_ok = 0; /* new samples since the last sweep */
-    for (s->recent_at = 0; s->recent_at < VPDSI_RECENT_COVERS; s->recent_at++) s->recent[s->recent_at] = -1;
-    s->recent_at = 0;
+    s->last_cover = -1;
 }
 
 /* The seed lattice of each live triangle: m = ceil(longest edge / (t * coverage * r)) pieces
@@ -417,7 +394,7 @@ static vpds_status sweep_one_piece(vpdsi_surface *s, const vpdsi_surface_ctx *ct
     int q;
     vpdsi_piece_corners(ctx->mesh, s->seed_m[p->tri], p, uv, x);
     if ((e = vpdsi_piece_bounds(ctx->mesh, ctx->st, p->tri, uv, x, &r_lo, &r_hi)) != VPDS_OK) return e;
-    if (recent_covers(s, ctx, x, r_lo)) return VPDS_OK;
+    if (s->last_cover >= 0 && holds_corners(s, ctx, s->last_cover, x, r_lo)) return VPDS_OK;
     if ((e = piece_near(s, ctx, x, r_hi, vpdsi_piece_edge(ctx->mesh, s->seed_m[p->tri], p))) != VPDS_OK)
         return e;
     if (corners_covered(s, ctx, x, r_lo)) return VPDS_OK;

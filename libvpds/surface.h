@@ -5,7 +5,6 @@
  * coordinates in the marks beside it. */
 #ifndef VPDS_SURFACE_H
 #define VPDS_SURFACE_H
-#define VPDSI_RECENT_COVERS 4
 #include "piece_array.h"
 #include "rng.h"
 
@@ -30,8 +29,7 @@ typedef struct vpdsi_surface {
     int32_t *cache; size_t n_cache, cap_cache; /* samples near a box around recent pieces */
     double cache_lo[3], cache_hi[3], cache_r;
     int cache_ok;
-    int32_t recent[VPDSI_RECENT_COVERS]; /* the samples that held the last covered pieces, -1 none */
-    unsigned recent_at;                  /* the slot the next one goes to */
+    int32_t last_cover;                  /* the sample that held the last covered piece */
     vpdsi_piece_array cur, next;         /* active pieces, and those of the next level */
     uint64_t m_max;                      /* the largest seed_m */
     double *cum;  size_t cap_cum;        /* running sums of the active pieces' areas */
