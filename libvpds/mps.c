@@ -404,18 +404,9 @@ static int uses_pencil(const vpdsi_ctx *ctx)
 static int box_held(const vpdsi_mps *m, const vpdsi_ctx *ctx, const double *lo, const double *hi, double r_lo,
                     double scale)
 {
-    const vpdsi_problem *pb = ctx->pb;
-    const vpdsi_store *st = ctx->st;
-    vpdsi_pencil pen;
-    size_t j;
-    vpdsi_pencil_reset(&pen, pb->dim, lo, hi);
-    for (j = 0; j < m->n_cand; j++) {
-        double f = scale * vpdsi_rule_f(pb->rule, st->r[m->cand[j]], r_lo);
-        if (f > 0 && vpdsi_pencil_take(&pen, pb->dim, st->x + (size_t)m->cand[j] * (size_t)pb->dim, f * f, lo, hi,
-                                       pb->period))
-            return 1;
-    }
-    return vpdsi_pencil_holds(&pen, pb->dim, lo, hi);
+    vpdsi_kd_samples view = vpdsi_store_view(ctx->st);
+    return vpdsi_pencil_list_holds(&view, m->cand, m->n_cand, ctx->pb->dim, ctx->pb->rule, scale, r_lo, lo, hi,
+                                   ctx->pb->period);
 }
 
 /* The candidate that holds the box [lo, hi] whole, or -1. */

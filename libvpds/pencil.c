@@ -1,5 +1,6 @@
 /* The ball two disks hold together (pencil.h). */
 #include "pencil.h"
+#include "rules.h"
 #include "torus.h"
 #include <float.h>
 #include <math.h>
@@ -71,8 +72,10 @@ int vpdsi_pencil_ball(const vpdsi_pencil *p, int d, int pair, double *y, double 
     return 1;
 }
 
-int vpdsi_pencil_take(vpdsi_pencil *p, int d, const double *x, double f2, const double *lo,
-                      const double *hi, const double *period)
+/* The disk (x, f2) against the box: 1 when it holds the box whole; else 0, offered when it
+ * reaches into the box. */
+static int take(vpdsi_pencil *p, int d, const double *x, double f2, const double *lo,
+                const double *hi, const double *period)
 {
     double far2 = 0, near2 = 0;
     int k;
@@ -89,7 +92,8 @@ int vpdsi_pencil_take(vpdsi_pencil *p, int d, const double *x, double f2, const 
     return 0;
 }
 
-int vpdsi_pencil_holds(const vpdsi_pencil *p, int d, const double *lo, const double *hi)
+/* Whether the ball of a pair of the kept disks holds the box whole. */
+static int pair_holds(const vpdsi_pencil *p, int d, const double *lo, const double *hi)
 {
     int pair, k;
     for (pair = 0; pair < VPDSI_PENCIL_PAIRS; pair++) {
@@ -102,4 +106,19 @@ int vpdsi_pencil_holds(const vpdsi_pencil *p, int d, const double *lo, const dou
         if (far2 <= r2) return 1;
     }
     return 0;
+}
+
+int vpdsi_pencil_list_holds(const vpdsi_kd_samples *s, const int32_t *cand, size_t n, int d,
+                            vpds_rule rule, double scale, double r_lo, const double *lo,
+                            const double *hi, const double *period)
+{
+    vpdsi_pencil pen;
+    size_t j;
+    vpdsi_pencil_reset(&pen, d, lo, hi);
+    for (j = 0; j < n; j++) {
+        double f = scale * vpdsi_rule_f(rule, s->r[cand[j]], r_lo);
+        if (f > 0 && take(&pen, d, s->x + (size_t)cand[j] * (size_t)d, f * f, lo, hi, period))
+            return 1;
+    }
+    return pair_holds(&pen, d, lo, hi);
 }

@@ -3,6 +3,7 @@
  * of the pair drops them before they split into 2^d children. */
 #ifndef VPDS_PENCIL_H
 #define VPDS_PENCIL_H
+#include "samples.h"
 #include "vpds.h"
 
 #define VPDSI_PENCIL_KEEP 3 /* disks kept per box: the pairs of more cost more than they drop */
@@ -24,13 +25,13 @@ void vpdsi_pencil_reset(vpdsi_pencil *p, int d, const double *lo, const double *
  * point, above f2). period: the box side on a periodic axis, 0 on an open one. */
 void vpdsi_pencil_offer(vpdsi_pencil *p, int d, const double *x, double f2, double far2,
                         const double *lo, const double *hi, const double *period);
-/* The disk (x, f2) against the box: 1 when it holds the box whole (the squared farthest
- * distance summed axis by axis, as the kd-tree's box test sums it); else 0, offered when it
- * reaches into the box. */
-int vpdsi_pencil_take(vpdsi_pencil *p, int d, const double *x, double f2, const double *lo,
-                      const double *hi, const double *period);
-/* Whether the ball of a pair of the kept disks holds the box whole. */
-int vpdsi_pencil_holds(const vpdsi_pencil *p, int d, const double *lo, const double *hi);
+/* Whether one sample of the list cand (n of them) holds the box [lo, hi] whole (its squared
+ * farthest distance summed axis by axis, as the kd-tree's box test sums it), or the ball of a
+ * pair of the kept ones does: each at the radius scale * f(r(x), r_lo) of `rule`, one pass
+ * over the list for both. */
+int vpdsi_pencil_list_holds(const vpdsi_kd_samples *s, const int32_t *cand, size_t n, int d,
+                            vpds_rule rule, double scale, double r_lo, const double *lo,
+                            const double *hi, const double *period);
 /* Pair `pair` (0 .. VPDSI_PENCIL_PAIRS - 1) of the kept disks a, b: a ball (centre y, squared
  * radius *r2) inside their union. Of the balls theta (|p - a|^2 - fa^2) + (1 - theta)
  * (|p - b|^2 - fb^2) <= 0 (a point of one has one term <= 0, so lies in a or b), the one centred

@@ -1,8 +1,9 @@
 /* Branch-and-bound over boxes of the region's bounding box: a box is dropped when it misses
  * the region, lies outside the domain or inside one sample's coverage disk (version 12, up to
  * 5D: or two samples' together, pencil.h); a box point inside the region and the domain and
- * outside every coverage disk is an uncovered witness; anything else splits into 2^d. Boxes live in coordinates around the anchor; on a periodic axis the
- * kd-tree wraps them. The search reads candidate lists handed down from box to sub-box. */
+ * outside every coverage disk is an uncovered witness; anything else splits into 2^d. Boxes
+ * live in coordinates around the anchor; on a periodic axis the kd-tree wraps them. The search
+ * reads candidate lists handed down from box to sub-box. */
 #include "uncovered.h"
 #include "pencil.h"
 #include "proximity.h"
@@ -201,21 +202,13 @@ static int32_t p_cover(bb_search *q, int depth, const double *p, double rp)
     return vpdsi_kd_conflict(&q->st->tree, &q->view, p, rp, (int)q->pb->rule, q->scale, -1.0, &q->w);
 }
 
-/* Version 12: whether two samples of the box's list hold it together (pencil.h), at radii
- * f(r(x), r_lo) as box_covered takes them. */
+/* Version 12: whether one sample of the box's list holds it, or two together (pencil.h), at
+ * radii f(r(x), r_lo) as box_covered takes them. */
 static int pencil_covers(const bb_search *q, const int32_t *cand, size_t n, const double *lo,
                          const double *hi, double r_lo)
 {
-    int d = q->pb->dim;
-    vpdsi_pencil pen;
-    size_t j;
-    vpdsi_pencil_reset(&pen, d, lo, hi);
-    for (j = 0; j < n; j++) {
-        double f = q->scale * vpdsi_rule_f(q->pb->rule, q->view.r[cand[j]], r_lo);
-        if (f > 0 && vpdsi_pencil_take(&pen, d, q->view.x + (size_t)cand[j] * (size_t)d, f * f, lo, hi, q->pb->period))
-            return 1; /* one disk holds it (box_covered found none: not reached) */
-    }
-    return vpdsi_pencil_holds(&pen, d, lo, hi);
+    return vpdsi_pencil_list_holds(&q->view, cand, n, q->pb->dim, q->pb->rule, q->scale, r_lo, lo, hi,
+                                   q->pb->period);
 }
 
 /* Whether one sample covers the whole box, r_lo <= r <= r_hi over it (gather, then the test),
@@ -234,6 +227,18 @@ static vpds_status search_box_covered(bb_search *q, int depth, const double *lo,
         return VPDS_OK;
     }
     q->u->n_lists = off;
+    if (q->pencil) {
+        /* the gather keeps only disks that may hold the whole box: the pencil reads every disk
+         * that reaches into it, as the lists hold them, so that both ways answer alike, and
+         * finds one that holds it alone as the gather's test would */
+        if (vpdsi_kd_near_box(&q->st->tree, &q->view, lo, hi, r_hi, q->scale, q->slack, SIZE_MAX, q->st->mem,
+                              &q->u->lists, &q->u->n_lists, &q->u->cap_lists) < 0) {
+            vpdsi_store_error(q->st, "out of memory listing the samples near a box");
+            return VPDS_ERR_OUT_OF_MEMORY;
+        }
+        *covered = r_lo > 0 && pencil_covers(q, q->u->lists + off, q->u->n_lists - off, lo, hi, r_lo);
+        return VPDS_OK;
+    }
     if (vpdsi_kd_gather(&q->st->tree, &q->view, lo, hi, r_hi, (int)q->pb->rule, q->scale, 0, q->st->mem,
                         &q->u->lists, &q->u->n_lists, &q->u->cap_lists)) {
         vpdsi_store_error(q->st, "out of memory gathering the samples near a box");
@@ -242,17 +247,6 @@ static vpds_status search_box_covered(bb_search *q, int depth, const double *lo,
     *covered = r_lo > 0 && vpdsi_kd_box_covered(&q->st->tree, &q->view, q->u->lists + off,
                                                 q->u->n_lists - off, lo, hi, r_lo, (int)q->pb->rule,
                                                 q->scale);
-    if (!*covered && q->pencil && r_lo > 0) {
-        /* the gather keeps only disks that may hold the whole box: the pencil reads every disk
-         * that reaches into it, as the lists hold them, so that both ways answer alike */
-        q->u->n_lists = off;
-        if (vpdsi_kd_near_box(&q->st->tree, &q->view, lo, hi, r_hi, q->scale, q->slack, SIZE_MAX, q->st->mem,
-                              &q->u->lists, &q->u->n_lists, &q->u->cap_lists) < 0) {
-            vpdsi_store_error(q->st, "out of memory listing the samples near a box");
-            return VPDS_ERR_OUT_OF_MEMORY;
-        }
-        *covered = pencil_covers(q, q->u->lists + off, q->u->n_lists - off, lo, hi, r_lo);
-    }
     return VPDS_OK;
 }
 
