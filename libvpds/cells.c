@@ -65,7 +65,14 @@ int vpdsi_cells_reserve(vpdsi_cells *c, vpdsi_mem *m, size_t cells)
         words = cells / 2 + cells % 2;
     else if (vpdsi_mul_size(cells, c->words_per_cell, &words))
         return -1;
-    return vpdsi_mem_reserve(m, (void **)&c->words, &c->cap_words, words, sizeof *c->words);
+    /* two levels' cells are held at once at the peak of a run: small steps leave less unused */
+    return vpdsi_mem_reserve_fine(m, (void **)&c->words, &c->cap_words, words, sizeof *c->words);
+}
+
+void vpdsi_cells_shrink(vpdsi_cells *c, vpdsi_mem *m)
+{
+    size_t words = c->words_per_cell == 0 ? c->count / 2 + c->count % 2 : c->count * c->words_per_cell;
+    vpdsi_mem_shrink(m, (void **)&c->words, &c->cap_words, words, sizeof *c->words);
 }
 
 /* The 32-bit cell i of a layout with words_per_cell 0. */

@@ -17,6 +17,8 @@ typedef struct vpdsi_cells {
 /* Empty the array and lay it out for `level` over a base grid of n0[k] cells per axis. */
 void vpdsi_cells_layout(vpdsi_cells *c, int dim, const uint64_t *n0, unsigned level);
 int vpdsi_cells_reserve(vpdsi_cells *c, vpdsi_mem *m, size_t cells);
+/* The room past the cells held given back (a level's cells, once its sweep made them all). */
+void vpdsi_cells_shrink(vpdsi_cells *c, vpdsi_mem *m);
 void vpdsi_cells_release(vpdsi_cells *c, vpdsi_mem *m);
 /* Append (after reserve; never allocates) and read back. */
 void vpdsi_cells_push(vpdsi_cells *c, int dim, const uint64_t *coord);

@@ -61,14 +61,16 @@ int vpdsi_mul_size(size_t a, size_t b, size_t *out)
     return 0;
 }
 
-int vpdsi_mem_reserve(vpdsi_mem *m, void **p, size_t *cap, size_t need, size_t elem)
+/* Make *cap >= need: half again, or past 1 MiB by *cap >> large_shift. realloc moves large
+ * blocks by remapping their pages, so the smaller steps cost little time and leave less room
+ * unused at the peak. */
+static int reserve_by(vpdsi_mem *m, void **p, size_t *cap, size_t need, size_t elem,
+                      unsigned large_shift)
 {
     size_t new_cap, old_bytes, new_bytes;
     void *q;
     if (need <= *cap) return 0;
-    /* half again, or a quarter past 1 MiB: realloc moves large blocks by remapping their pages,
-     * so the smaller steps cost little time and leave less room unused at the peak */
-    new_cap = *cap + (*cap * elem > ((size_t)1 << 20) ? *cap / 4 : *cap / 2) + 16;
+    new_cap = *cap + (*cap * elem > ((size_t)1 << 20) ? *cap >> large_shift : *cap / 2) + 16;
     if (new_cap < *cap || new_cap < need) new_cap = need;
     if (vpdsi_mul_size(new_cap, elem, &new_bytes) != 0) {
         new_cap = need;
@@ -95,4 +97,30 @@ int vpdsi_mem_reserve(vpdsi_mem *m, void **p, size_t *cap, size_t need, size_t e
     *p = q;
     *cap = new_cap;
     return 0;
+}
+
+int vpdsi_mem_reserve(vpdsi_mem *m, void **p, size_t *cap, size_t need, size_t elem)
+{
+    return reserve_by(m, p, cap, need, elem, 2);
+}
+
+int vpdsi_mem_reserve_fine(vpdsi_mem *m, void **p, size_t *cap, size_t need, size_t elem)
+{
+    return reserve_by(m, p, cap, need, elem, 3);
+}
+
+void vpdsi_mem_shrink(vpdsi_mem *m, void **p, size_t *cap, size_t keep, size_t elem)
+{
+    size_t old_bytes = *cap * elem, new_bytes;
+    void *q;
+    if (keep == 0) keep = 1; /* a block of no bytes is the allocator's corner case */
+    /* without realloc a shrink would copy into a second block, the two held at once: the
+     * peak it is meant to lower would rise */
+    if (!*p || keep >= *cap || !m->a.realloc) return;
+    new_bytes = keep * elem; /* below *cap * elem: no overflow */
+    q = m->a.realloc(*p, old_bytes, new_bytes, m->a.user);
+    if (!q) return; /* the block stays as it was: nothing is lost */
+    *p = q;
+    *cap = keep;
+    m->held -= old_bytes - new_bytes;
 }

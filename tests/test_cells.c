@@ -57,9 +57,71 @@ static void check_layout(int d, const uint64_t *n0, unsigned level, size_t n)
         vpdsi_cells_get(&c, i, d, got);
         same &= memcmp(got, copy + i * d, (size_t)d * sizeof *got) == 0;
     }
+    /* the room past the cells kept given back: exactly the words they take, the same cells */
+    c.count = kept; /* as the two radii' filter ends its compaction */
+    vpdsi_cells_shrink(&c, &mem);
+    CHECK_MSG(c.cap_words == (c.words_per_cell ? kept * c.words_per_cell : (kept + 1) / 2) &&
+                  mem.held == c.cap_words * sizeof *c.words,
+              "dim %d, level %u: %zu words held for %zu cells after a shrink", d, level, c.cap_words, kept);
+    for (i = 0; i < kept; i++) {
+        vpdsi_cells_get(&c, i, d, got);
+        same &= memcmp(got, copy + i * d, (size_t)d * sizeof *got) == 0;
+    }
     CHECK_MSG(same, "dim %d, level %u, %u bits: a cell read back differs", d, level, bits);
     vpdsi_cells_release(&c, &mem);
+    CHECK(mem.held == 0);
     free(copy);
+}
+
+static void *refuse_realloc(void *p, size_t old_size, size_t new_size, void *user)
+{
+    (void)p; (void)old_size; (void)new_size; (void)user;
+    return NULL;
+}
+
+/* A shrink the allocator refuses, or one without a realloc (it would hold two blocks at once),
+ * leaves the cells and the bytes held as they were; the growth past 1 MiB is by an eighth. */
+static void check_shrink_refused(void)
+{
+    uint64_t n0[2] = {1000, 1000}, c2[2], got[2];
+    vpdsi_mem mem;
+    vpdsi_cells c;
+    size_t i, cap, held;
+    int pass, same = 1;
+    for (pass = 0; pass < 2; pass++) {
+        vpdsi_mem_init(&mem, NULL);
+        memset(&c, 0, sizeof c);
+        vpdsi_cells_layout(&c, 2, n0, 0);
+        CHECK(vpdsi_cells_reserve(&c, &mem, 1000) == 0);
+        for (i = 0; i < 100; i++) {
+            c2[0] = i;
+            c2[1] = 999 - i;
+            vpdsi_cells_push(&c, 2, c2);
+        }
+        cap = c.cap_words;
+        held = mem.held;
+        if (pass == 0) mem.a.realloc = refuse_realloc;
+        else mem.a.realloc = NULL;
+        vpdsi_cells_shrink(&c, &mem);
+        CHECK_MSG(c.cap_words == cap && mem.held == held, "pass %d: a refused shrink changed the room", pass);
+        for (i = 0; i < 100; i++) {
+            vpdsi_cells_get(&c, i, 2, got);
+            same &= got[0] == i && got[1] == 999 - i;
+        }
+        vpdsi_cells_release(&c, &mem);
+        CHECK(mem.held == 0);
+    }
+    CHECK_MSG(same, "a cell changed under a refused shrink");
+    /* 4 MiB of 32-bit cells grow by an eighth (vpdsi_mem_reserve_fine) where other arrays grow
+     * by a quarter */
+    vpdsi_mem_init(&mem, NULL);
+    memset(&c, 0, sizeof c);
+    vpdsi_cells_layout(&c, 2, n0, 0);
+    CHECK(vpdsi_cells_reserve(&c, &mem, (size_t)1 << 20) == 0);
+    cap = c.cap_words;
+    CHECK(vpdsi_cells_reserve(&c, &mem, 2 * cap + 2) == 0);
+    CHECK_MSG(c.cap_words == cap + cap / 8 + 16, "%zu words after growing from %zu", c.cap_words, cap);
+    vpdsi_cells_release(&c, &mem);
 }
 
 static vpdsi_piece random_piece(unsigned bits)
@@ -128,6 +190,7 @@ static void check_pieces(void)
 int main(void)
 {
     check_pieces();
+    check_shrink_refused();
     int d, rep;
     unsigned level;
     for (d = 1; d <= VPDS_MAX_DIM; d++)
