@@ -22,10 +22,11 @@ static double jamming_density(int d)
 }
 
 /* Most active cells per base cell, measured with vpds_stats.peak_active_cells on uniform runs
- * of 10^3-10^5 samples (2D: level 0 counted whole); past 8D doubled per axis. */
+ * of 10^3-10^5 samples (2D: level 0 counted whole; 6D and 7D with algorithm version 12, whose
+ * pairs of disks drop cells: 2.8-5.9 in 6D, 4.5 in 7D); past 8D doubled per axis. */
 static double cells_per_base_cell(int d)
 {
-    static const double c[9] = {0, 1, 1, 1.5, 4, 10, 11, 20, 32};
+    static const double c[9] = {0, 1, 1, 1.5, 4, 10, 6, 8, 32};
     return d <= 8 ? c[d] : c[8] * pow(2, d - 8);
 }
 
@@ -36,14 +37,22 @@ static double cells_per_base_cell(int d)
 #define BYTES_PER_CELL_WORD 16.0
 
 /* Bytes per active cell on the base grid of cells of side `side` over the box: its coordinates
- * at level 2, where runs hold the most cells, in 32 bits or in 64-bit words. */
+ * at level 2, where runs hold the most cells, in 32 bits or in 64-bit words; kept as families
+ * (cells.h), a record per parent shared by its children (measured at level 2 with algorithm
+ * version 12: 2.6 in 3D, 3.7 in 4D, 5.5 in 5D, 7.5 in 6D, 11.6 in 7D, 22 in 8D, about
+ * 0.9 2^(d/2)), and a bucket entry of 9 bytes per 64 cells. */
 static double bytes_per_cell(const vpdsi_problem *pb, double side)
 {
-    double bits = 0;
+    double bits = 0, parent_bytes, record_bytes;
     int k;
     for (k = 0; k < pb->dim; k++) /* cells.c's layout: the bits of n0, plus one per level */
         bits += vpdsi_bit_length((uint64_t)ceil((pb->hi[k] - pb->lo[k]) / side)) + 2;
-    return bits <= 32 ? BYTES_PER_CELL_WORD / 2 : BYTES_PER_CELL_WORD * ceil(bits / 64);
+    if (!vpdsi_cells_families_serve(pb->dim, pb->two_radii))
+        return bits <= 32 ? BYTES_PER_CELL_WORD / 2 : BYTES_PER_CELL_WORD * ceil(bits / 64);
+    bits -= pb->dim; /* the parents' level */
+    parent_bytes = bits <= 32 ? 4 : 8 * ceil(bits / 64);
+    record_bytes = (pb->dim > 3 ? (double)(1u << (pb->dim - 3)) : 1.0) + parent_bytes;
+    return BYTES_PER_CELL_WORD / 8 * (record_bytes / (0.9 * pow(2, pb->dim / 2.0)) + 9.0 / 64);
 }
 
 static double bytes_per_sample(int d)

@@ -206,6 +206,15 @@ static void cell_coords(const vpdsi_mps *m, const vpdsi_ctx *ctx, uint64_t idx, 
     }
 }
 
+/* The same for cells read in order (the sweep's): on from the last one read. */
+static void seq_coords(vpdsi_mps *m, const vpdsi_ctx *ctx, uint64_t idx, uint64_t *c)
+{
+    if (m->run.implicit)
+        cell_coords(m, ctx, idx, c);
+    else
+        vpdsi_cells_get_seq(&m->run.cur, (size_t)idx, ctx->pb->dim, c);
+}
+
 static unsigned cur_level(const vpdsi_mps *m) { return m->run.implicit ? 0 : m->run.cur.level; }
 
 static uint64_t cur_count(const vpdsi_mps *m)
@@ -218,11 +227,14 @@ static uint64_t cur_count(const vpdsi_mps *m)
 #endif
 /* A copy of the dart generator CELL_PREFETCH darts ahead: the cell it will draw is asked for
  * (the cells lie anywhere in memory), then its draws are spent as the dart's. */
-static void prefetch_ahead(const vpdsi_mps *m, vpdsi_rng *ahead, uint64_t total, int d, int with_u)
+static void prefetch_ahead(const vpdsi_mps *m, vpdsi_rng *ahead, uint64_t total, int d, int with_u, int bucket)
 {
     uint64_t idx = vpdsi_rng_below(ahead, total);
     int k;
-    if (!m->run.implicit) vpdsi_cells_prefetch(&m->run.cur, (size_t)idx);
+    if (bucket)
+        vpdsi_cells_prefetch_bucket(&m->run.cur, (size_t)idx);
+    else if (!m->run.implicit)
+        vpdsi_cells_prefetch(&m->run.cur, (size_t)idx);
     for (k = 0; k < d + with_u; k++) (void)vpdsi_rng_unit(ahead);
 }
 
@@ -235,10 +247,13 @@ static void draw_darts(const vpdsi_mps *m, const vpdsi_ctx *ctx, vpdsi_rng *rng,
     unsigned level = cur_level(m);
     size_t j;
     int k, d = ctx->pb->dim, ahead_on = !m->run.implicit && n > CELL_PREFETCH;
-    vpdsi_rng ahead = *rng;
-    for (j = 0; ahead_on && j < CELL_PREFETCH; j++) prefetch_ahead(m, &ahead, total, d, u != NULL);
+    int two = ahead_on && m->run.cur.families && n > 2 * CELL_PREFETCH; /* bucket, then family */
+    vpdsi_rng ahead = *rng, ahead2 = *rng;
+    for (j = 0; two && j < 2 * CELL_PREFETCH; j++) prefetch_ahead(m, &ahead2, total, d, u != NULL, 1);
+    for (j = 0; ahead_on && j < CELL_PREFETCH; j++) prefetch_ahead(m, &ahead, total, d, u != NULL, 0);
     for (j = 0; j < n; j++) {
-        if (ahead_on && j + CELL_PREFETCH < n) prefetch_ahead(m, &ahead, total, d, u != NULL);
+        if (two && j + 2 * CELL_PREFETCH < n) prefetch_ahead(m, &ahead2, total, d, u != NULL, 1);
+        if (ahead_on && j + CELL_PREFETCH < n) prefetch_ahead(m, &ahead, total, d, u != NULL, 0);
         cell_coords(m, ctx, vpdsi_rng_below(rng, total), c);
         vpdsi_lattice_box(&m->run.geom, level, c, lo, hi);
         for (k = 0; k < d; k++) {
@@ -654,7 +669,7 @@ static vpds_status centre_radii(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, un
     size_t j;
     if ((e = reserve_buffers(m, ctx, n)) != VPDS_OK) return e;
     for (j = 0; j < n; j++) {
-        cell_coords(m, ctx, m->run.pos + j, c);
+        seq_coords(m, ctx, m->run.pos + j, c);
         vpdsi_lattice_box(&m->run.geom, level, c, lo, hi);
         for (k = 0; k < d; k++) m->buf_x[j * (size_t)d + (size_t)k] = 0.5 * (lo[k] + hi[k]);
     }
@@ -881,6 +896,14 @@ static vpds_status sweep_block(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_
     if (pb->two_radii &&
         (e = flag_uncovered(m, ctx, level, c, split, block, whole_c, r_lo, covered, flag)) != VPDS_OK)
         return e;
+    if (run->next.families) { /* one record for the children left (one block: d <= 8) */
+        uint64_t keep[4];
+        unsigned w;
+        for (w = 0; w < 4; w++) keep[w] = ~covered[w];
+        if (children < 64) keep[0] &= (UINT64_C(1) << children) - 1;
+        vpdsi_cells_push_family(&run->next, d, c, keep);
+        return VPDS_OK;
+    }
     for (b = 0; b < children; b++) {
         if (bit_set(covered, b)) continue;
         if (pb->two_radii) m->unc.flag[run->next.count] = flag[b];
@@ -908,7 +931,7 @@ static vpds_status sweep_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t
     double h = sqrt(vpdsi_lattice_box(&run->geom, level, c, lo, hi));
     double r_lo = need_r ? rc - L * h / 2 : st->sizing.radius;
     double r_hi = need_r ? rc + L * h / 2 : st->sizing.radius;
-    size_t kept = run->next.count, records = m->unc.n_nwit;
+    size_t kept = run->next.count, kept_fam = run->next.n_fam, records = m->unc.n_nwit;
     uint64_t known[4] = {0, 0, 0, 0};
     const uint64_t *pre = NULL; /* the children's bits when decided here */
     int32_t holder;
@@ -934,6 +957,7 @@ static vpds_status sweep_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t
     for (block = 0; block < blocks; block++) {
         if ((e = sweep_block(m, ctx, c, split, block, r_lo, centre, phi, h, whole_c, pre)) != VPDS_OK) {
             run->next.count = kept;
+            run->next.n_fam = kept_fam;
             m->unc.n_nwit = records;
             return e;
         }
@@ -955,7 +979,8 @@ static vpds_status sweep_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, int
     size_t j, need;
     vpds_status e;
     if (vpdsi_mul_size(n, children, &need) ||
-        vpdsi_cells_reserve(&run->next, ctx->mem, run->next.count + need) ||
+        (run->next.families ? vpdsi_cells_reserve_families(&run->next, ctx->mem, n, pb->dim)
+                            : vpdsi_cells_reserve(&run->next, ctx->mem, run->next.count + need)) ||
         (pb->two_radii && vpdsi_mem_reserve(ctx->mem, (void **)&m->unc.flag, &m->unc.cap_flag,
                                             run->next.count + need, 1)) ||
         (pb->two_radii && pb->algorithm >= 4 &&
@@ -966,7 +991,7 @@ static vpds_status sweep_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, int
     uint64_t boxes0 = m->unc.boxes;
     if (need_r && (e = centre_radii(m, ctx, n, cur_level(m))) != VPDS_OK) return e;
     for (j = 0; j < n; j++) {
-        cell_coords(m, ctx, run->pos, c);
+        seq_coords(m, ctx, run->pos, c);
         if ((e = sweep_cell(m, ctx, c, need_r ? m->buf_r[j] : 0.0, need_r, split)) != VPDS_OK)
             return e;
         run->pos++;
@@ -1041,7 +1066,7 @@ static void finish_sweep(vpdsi_mps *m, const vpdsi_ctx *ctx, int split)
         size_t i;
         for (i = 0; i < run->cur.count; i++) {
             double dg;
-            vpdsi_cells_get(&run->cur, i, ctx->pb->dim, c);
+            vpdsi_cells_get_seq(&run->cur, i, ctx->pb->dim, c);
             dg = sqrt(vpdsi_lattice_box(&m->run.geom, run->cur.level, c, lo, hi));
             if (dg > worst) worst = dg;
         }
@@ -1056,7 +1081,12 @@ static void finish_sweep(vpdsi_mps *m, const vpdsi_ctx *ctx, int split)
 
 static void begin_sweep(vpdsi_mps *m, const vpdsi_ctx *ctx, int split)
 {
-    vpdsi_cells_layout(&m->run.next, ctx->pb->dim, m->run.geom.n0, cur_level(m) + (split ? 1u : 0u));
+    /* a split's children as families (cells.h): a parent's record where its children each
+     * took one (one block of children each: BLOCK_BITS is 8) */
+    if (split && vpdsi_cells_families_serve(ctx->pb->dim, ctx->pb->two_radii))
+        vpdsi_cells_layout_families(&m->run.next, ctx->pb->dim, m->run.geom.n0, cur_level(m) + 1u);
+    else
+        vpdsi_cells_layout(&m->run.next, ctx->pb->dim, m->run.geom.n0, cur_level(m) + (split ? 1u : 0u));
     m->run.pos = 0;
     m->unc.n_nwit = 0; /* the witness records of this sweep's flagged cells */
     m->strip.key = m->base.key = 0; /* new samples, and with a new scale new base cells */

@@ -441,10 +441,11 @@ int main(void)
     /* allocator: count the allocations of a run, then fail each one in turn (a variable-radius
      * run on the kd-tree, a uniform one on the background grid, two radii with a variable
      * radius: the coverage search and what its index learns, and a domain: the domain's search
-     * takes its first lists from the grid, or from the kd-tree, built then, when they fail) */
+     * takes its first lists from the grid, or from the kd-tree, built then, when they fail;
+     * and a uniform one in 3D, whose split levels keep their cells as families) */
     {
         int which;
-        for (which = 0; which < 4; which++) {
+        for (which = 0; which < 5; which++) {
             counting_alloc ca;
             vpds_sampler *s = NULL;
             size_t total, k, reached = 0, n_base, sites;
@@ -466,13 +467,18 @@ int main(void)
                 d.radius = quick ? 0.02 : 0.006; /* 20,000 samples: a few batches (valgrind: 1,800) */
                 d.domain = disk_domain;
                 d.seed = 9;
+            } else if (which == 4) {
+                d = vpds_default_desc();
+                d.dim = 3;
+                d.radius = quick ? 0.2 : 0.1; /* 1,500 samples (valgrind: 200) */
+                d.seed = 4;
             }
             base = run_copy(&d, &n_base);
             d.allocator.alloc = ca_alloc;
             d.allocator.free = ca_free;
             d.allocator.user = &ca;
             CHECK(vpds_create(&d, &s) == VPDS_OK && vpds_run(s) == VPDS_OK);
-            CHECK(vpds_count(s) == n_base && memcmp(vpds_points(s), base, n_base * 2 * sizeof(double)) == 0);
+            CHECK(vpds_count(s) == n_base && memcmp(vpds_points(s), base, n_base * (size_t)d.dim * sizeof(double)) == 0);
             vpds_destroy(s);
             CHECK(ca.live_bytes == 0);
             total = ca.calls;
@@ -492,7 +498,7 @@ int main(void)
                         reached++;
                     }
                     CHECK_MSG(st == VPDS_OK && vpds_count(s) == n_base &&
-                              memcmp(vpds_points(s), base, n_base * 2 * sizeof(double)) == 0,
+                              memcmp(vpds_points(s), base, n_base * (size_t)d.dim * sizeof(double)) == 0,
                               "after failing allocation %zu", k);
                     vpds_destroy(s);
                 } else {
@@ -506,12 +512,13 @@ int main(void)
              * the run falls back to the kd-tree, with the same points as checked above; so may
              * the coverage search's candidate lists (its tests then read the kd-trees), which
              * two radii and a domain's search both use, and the domain's search's buffer for the
-             * grid's candidates (it then reads the kd-tree) */
-            CHECK_MSG(reached <= total && total - reached <= (which == 1 ? 10u : which == 3 ? 12u : which == 2 ? 1u : 0u),
+             * grid's candidates (it then reads the kd-tree); in 3D the grid makes 14, as many
+             * as before the families (whose every allocation is seen) */
+            CHECK_MSG(reached <= total && total - reached <= (which == 1 ? 10u : which == 4 ? 14u : which == 3 ? 12u : which == 2 ? 1u : 0u),
                       "%zu of %zu failing allocations went unseen", total - reached, total);
             printf("allocation failure (%s): %zu allocations from %zu call sites (0: not counted in"
                    " this build), each failed once, %zu seen as VPDS_ERR_OUT_OF_MEMORY\n",
-                   which == 3 ? "uniform, a domain" : which == 2 ? "ramp, two radii" : which ? "uniform, grid" : "ramp, kd-tree", total,
+                   which == 4 ? "3D uniform, families" : which == 3 ? "uniform, a domain" : which == 2 ? "ramp, two radii" : which ? "uniform, grid" : "ramp, kd-tree", total,
                    sites, reached);
             free(base);
         }

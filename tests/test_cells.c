@@ -73,6 +73,74 @@ static void check_layout(int d, const uint64_t *n0, unsigned level, size_t n)
     free(copy);
 }
 
+/* Families (cells.h) against the flat list of the same children, for d = 1..8 at random
+ * levels: a sweep's order (vpdsi_cells_get_seq), a dart's (vpdsi_cells_get, random), a cut
+ * back to an earlier family and pushed again (a sweep's retry after an error), a shrink. */
+static void check_families(int d, unsigned level, size_t parents)
+{
+    vpdsi_mem mem;
+    vpdsi_cells c;
+    uint64_t n0[VPDS_MAX_DIM], parent[VPDS_MAX_DIM], got[VPDS_MAX_DIM], bits[4];
+    size_t cap = parents << d, n = 0, i, f, cut_n = 0, cut_fam = 0;
+    uint64_t *flat = (uint64_t *)malloc(cap * (size_t)d * sizeof *flat);
+    unsigned children = 1u << d, b, w;
+    int k, same = 1, pass;
+    for (k = 0; k < d; k++) n0[k] = 1 + next_u64() % 40;
+    vpdsi_mem_init(&mem, NULL);
+    memset(&c, 0, sizeof c);
+    vpdsi_cells_layout_families(&c, d, n0, level);
+    CHECK(flat != NULL && vpdsi_cells_reserve_families(&c, &mem, parents, d) == 0);
+    for (pass = 0; pass < 2; pass++) {
+        for (f = pass ? cut_fam : 0; f < parents; f++) {
+            for (k = 0; k < d; k++) parent[k] = next_u64() % (n0[k] << (level - 1));
+            memset(bits, 0, sizeof bits);
+            for (b = 0; b < children; b++) /* sparse, dense, empty and full families */
+                if (next_u64() % 4 < (f % 4)) bits[b / 64] |= UINT64_C(1) << (b % 64);
+            if (f % 7 == 0)
+                for (w = 0; w < 4; w++) bits[w] = children >= 64 * (w + 1) ? ~UINT64_C(0) : children > 64 * w ? (UINT64_C(1) << (children % 64)) - 1 : 0;
+            if (!pass && f == parents / 2) { /* where the cut will go back to */
+                cut_n = c.count;
+                cut_fam = c.n_fam;
+            }
+            vpdsi_cells_push_family(&c, d, parent, bits);
+            for (b = 0; b < children; b++) {
+                if (!((bits[b / 64] >> (b % 64)) & 1u)) continue;
+                for (k = 0; k < d; k++) flat[n * (size_t)d + (size_t)k] = 2 * parent[k] + ((b >> k) & 1u);
+                n++;
+            }
+        }
+        CHECK_MSG(c.count == n, "dim %d: %zu cells held, %zu pushed", d, c.count, n);
+        for (i = 0; i < n; i++) {
+            vpdsi_cells_get_seq(&c, i, d, got);
+            same &= memcmp(got, flat + i * (size_t)d, (size_t)d * sizeof *got) == 0;
+        }
+        for (i = 0; i < 3 * n; i++) {
+            size_t at = (size_t)(next_u64() % (n ? n : 1));
+            if (!n) break;
+            if (i % 2) vpdsi_cells_get(&c, at, d, got);
+            else vpdsi_cells_get_seq(&c, at, d, got);
+            same &= memcmp(got, flat + at * (size_t)d, (size_t)d * sizeof *got) == 0;
+        }
+        if (!pass) { /* the cut: the families after it are pushed again, others this time */
+            c.count = cut_n;
+            c.n_fam = cut_fam;
+            n = cut_n;
+        }
+    }
+    CHECK_MSG(same, "dim %d, level %u: a family's cell read back differs", d, level);
+    vpdsi_cells_shrink(&c, &mem);
+    for (i = 0; i < n; i++) {
+        vpdsi_cells_get(&c, i, d, got);
+        same &= memcmp(got, flat + i * (size_t)d, (size_t)d * sizeof *got) == 0;
+    }
+    CHECK_MSG(same, "dim %d, level %u: a cell differs after a shrink", d, level);
+    CHECK_MSG(c.cap_fam == c.n_fam * c.fam_bytes, "dim %d: %zu bytes held for %zu families of %u", d, c.cap_fam,
+              c.n_fam, c.fam_bytes);
+    vpdsi_cells_release(&c, &mem);
+    CHECK(mem.held == 0);
+    free(flat);
+}
+
 static void *refuse_realloc(void *p, size_t old_size, size_t new_size, void *user)
 {
     (void)p; (void)old_size; (void)new_size; (void)user;
@@ -189,10 +257,13 @@ static void check_pieces(void)
 
 int main(void)
 {
-    check_pieces();
-    check_shrink_refused();
     int d, rep;
     unsigned level;
+    check_pieces();
+    check_shrink_refused();
+    for (d = 1; d <= 8; d++)
+        for (level = 1; level < 30; level += 7)
+            check_families(d, level, d <= 4 ? 3000 : 300);
     for (d = 1; d <= VPDS_MAX_DIM; d++)
         for (rep = 0; rep < 6; rep++)
             for (level = 0; level < 40; level += 1 + level / 4) {
