@@ -129,6 +129,13 @@ static void half_set(vpdsi_cells *c, size_t i, uint32_t v)
     memcpy((unsigned char *)c->words + i * sizeof v, &v, sizeof v);
 }
 
+void vpdsi_cells_empty(vpdsi_cells *c, vpdsi_mem *m)
+{
+    c->count = c->n_fam = 0;
+    c->seq_set = 0;
+    vpdsi_cells_shrink(c, m);
+}
+
 void vpdsi_cells_release(vpdsi_cells *c, vpdsi_mem *m)
 {
     vpdsi_mem_free(m, c->words, c->cap_words * sizeof *c->words);

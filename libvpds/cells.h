@@ -54,6 +54,10 @@ int vpdsi_cells_reserve_families(vpdsi_cells *c, vpdsi_mem *m, size_t more, int 
 void vpdsi_cells_push_family(vpdsi_cells *c, int dim, const uint64_t *parent, const uint64_t *children);
 /* The room past the cells held given back (a level's cells, once its sweep made them all). */
 void vpdsi_cells_shrink(vpdsi_cells *c, vpdsi_mem *m);
+/* Empty the array and give back its room as a shrink does: through realloc, which keeps a
+ * large block mapped (a free would raise glibc's mmap threshold, and the blocks that follow
+ * would come from the heap, which keeps their pages: 19 MiB more at the ramp's peak). */
+void vpdsi_cells_empty(vpdsi_cells *c, vpdsi_mem *m);
 void vpdsi_cells_release(vpdsi_cells *c, vpdsi_mem *m);
 /* Append (after reserve; never allocates) and read back. */
 void vpdsi_cells_push(vpdsi_cells *c, int dim, const uint64_t *coord);

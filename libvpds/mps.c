@@ -1050,8 +1050,11 @@ static void finish_sweep(vpdsi_mps *m, const vpdsi_ctx *ctx, int split)
     vpdsi_cells tmp = run->cur;
     run->cur = run->next;
     run->next = tmp;
-    /* the next sweep holds these cells beside the ones it makes: the run's peak */
+    /* the next sweep holds these cells beside the ones it makes: the run's peak; the level
+     * before, emptied, gives its room back (held through the darts, it was larger than this
+     * one past the largest level) */
     vpdsi_cells_shrink(&run->cur, ctx->mem);
+    vpdsi_cells_empty(&run->next, ctx->mem);
     run->implicit = 0;
     run->pos = 0;
     if (run->cur.count > ctx->stats->peak_active_cells) ctx->stats->peak_active_cells = run->cur.count;

@@ -57,7 +57,7 @@ int vpdsi_ogrid_reserve(vpdsi_ogrid *g, vpdsi_mem *m, size_t n_total, size_t mor
     size_t cap = g->cap ? g->cap : 64, i;
     uint64_t *keys;
     int32_t *heads;
-    if (vpdsi_mem_reserve(m, (void **)&g->next, &g->cap_next, n_total, sizeof *g->next)) return -1;
+    if (vpdsi_mem_reserve_fine(m, (void **)&g->next, &g->cap_next, n_total, sizeof *g->next)) return -1;
     while (cap / 2 < g->used + more) {
         if (cap > ((size_t)-1) / 4 / sizeof *keys) return -1;
         cap *= 2;

@@ -97,10 +97,12 @@ static vpds_status store_reserve(vpdsi_store *st, size_t more, int index)
     }
     want = need <= st->expect ? st->expect : need; /* the expected count in one allocation */
     if (want != need) nx = want * (size_t)st->dim; /* expect <= VPDSI_STORE_EXPECT_MAX */
-    if (vpdsi_mem_reserve(m, (void **)&st->x, &st->cap_x, nx, sizeof(double)) ||
-        vpdsi_mem_reserve(m, (void **)&st->r, &st->cap_r, want, sizeof(double)) ||
-        vpdsi_mem_reserve(m, (void **)&st->t, &st->cap_t, want, sizeof(double)) ||
-        vpdsi_mem_reserve(m, (void **)&st->flags, &st->cap_flags, want, 1) ||
+    /* the arrays grow in small steps: a run whose count is not expected up front (a variable
+     * radius) holds their unused room at its peak */
+    if (vpdsi_mem_reserve_fine(m, (void **)&st->x, &st->cap_x, nx, sizeof(double)) ||
+        vpdsi_mem_reserve_fine(m, (void **)&st->r, &st->cap_r, want, sizeof(double)) ||
+        vpdsi_mem_reserve_fine(m, (void **)&st->t, &st->cap_t, want, sizeof(double)) ||
+        vpdsi_mem_reserve_fine(m, (void **)&st->flags, &st->cap_flags, want, 1) ||
         (index && !st->grid_mode && !st->ogrid_mode &&
          vpdsi_kd_reserve(&st->tree, m, need, need - st->tree_n)) ||
         (st->ogrid_mode && vpdsi_ogrid_reserve(&st->ogrid, m, need, more))) {

@@ -136,6 +136,20 @@ static void check_families(int d, unsigned level, size_t parents)
     CHECK_MSG(same, "dim %d, level %u: a cell differs after a shrink", d, level);
     CHECK_MSG(c.cap_fam == c.n_fam * c.fam_bytes, "dim %d: %zu bytes held for %zu families of %u", d, c.cap_fam,
               c.n_fam, c.fam_bytes);
+    /* emptied (a level past its use): no cell, a byte of room each, and it fills again */
+    vpdsi_cells_empty(&c, &mem);
+    CHECK_MSG(c.count == 0 && c.n_fam == 0 && c.cap_fam == 1 && c.cap_bucket_fam == 1 && c.cap_bucket_off == 1 &&
+                  mem.held == sizeof *c.bucket_fam + 2,
+              "dim %d: %zu bytes held once emptied", d, mem.held);
+    if (n > 0 && vpdsi_cells_reserve_families(&c, &mem, 1, d) == 0) {
+        uint64_t all[VPDSI_CELLS_MAX_WORDS], parent[VPDS_MAX_DIM] = {0};
+        unsigned w;
+        for (w = 0; w < VPDSI_CELLS_MAX_WORDS; w++) all[w] = w == 0 && d < 6 ? (UINT64_C(1) << (1u << d)) - 1 : ~UINT64_C(0);
+        vpdsi_cells_push_family(&c, d, parent, all);
+        vpdsi_cells_get(&c, c.count - 1, d, got);
+        for (k = 0; k < d; k++) same &= got[k] == 1;
+        CHECK_MSG(same && c.count == ((size_t)1 << d), "dim %d: a family pushed after emptying reads back wrong", d);
+    }
     vpdsi_cells_release(&c, &mem);
     CHECK(mem.held == 0);
     free(flat);
