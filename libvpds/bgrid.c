@@ -235,9 +235,9 @@ size_t vpdsi_bgrid_near(const vpdsi_bgrid *g, uint64_t at, int32_t *out)
 #define BGRID_PREFETCH_SAMPLES 2 /* the nearest samples whose points stage 1 asks for */
 #endif
 
-void vpdsi_bgrid_prefetch(const vpdsi_bgrid *g, const double *x, const double *y, int stage)
+void vpdsi_bgrid_prefetch(const vpdsi_bgrid *g, const double *x, uint64_t at, int stage)
 {
-    const int32_t *cell = g->cell + vpdsi_bgrid_locate(g, y);
+    const int32_t *cell = g->cell + at;
     int64_t w = (int64_t)g->pad, a;
     size_t j, asked = 0;
     if (g->dim != 2) return;
@@ -308,9 +308,9 @@ size_t vpdsi_bgrid_slide(const vpdsi_bgrid *g, const double *x, uint64_t at, int
     return kept;
 }
 
-int32_t vpdsi_bgrid_conflict(const vpdsi_bgrid *g, const double *x, const double *y, double reach)
+int32_t vpdsi_bgrid_conflict(const vpdsi_bgrid *g, const double *x, uint64_t at, const double *y, double reach)
 {
-    const int32_t *cell = g->cell + vpdsi_bgrid_locate(g, y);
+    const int32_t *cell = g->cell + at;
     double reach2 = reach * reach;
     size_t j;
     int k, d = g->dim;

@@ -63,12 +63,12 @@ uint64_t vpdsi_bgrid_index(const vpdsi_bgrid *g, const uint64_t *c);
 /* Samples within reach of the cell at padded index at (its own first), appended to out
  * (capacity >= 1 + n_stencil). */
 size_t vpdsi_bgrid_near(const vpdsi_bgrid *g, uint64_t at, int32_t *out);
-/* Asks the caches for what vpdsi_bgrid_conflict(g, x, y, .) will read, a few darts ahead of
+/* Asks the caches for what vpdsi_bgrid_conflict(g, x, at, y, .) will read, a few darts ahead of
  * it: stage 0 the rows of cells of its stencil, stage 1 (later, those rows cached) the points
  * in x of the nearest samples it will test. A dart's cells and samples lie anywhere in memory
  * (the samples in the order of their acceptance), and the chunk's darts are drawn before they
  * are judged. A hint only: nothing changes. */
-void vpdsi_bgrid_prefetch(const vpdsi_bgrid *g, const double *x, const double *y, int stage);
+void vpdsi_bgrid_prefetch(const vpdsi_bgrid *g, const double *x, uint64_t at, int stage);
 /* vpdsi_bgrid_near with, per sample, its tag and its point (d doubles, from x) into px. */
 size_t vpdsi_bgrid_near_packed(const vpdsi_bgrid *g, const double *x, uint64_t at, int32_t *out,
                                double *px, uint16_t *tag);
@@ -78,6 +78,7 @@ size_t vpdsi_bgrid_near_packed(const vpdsi_bgrid *g, const double *x, uint64_t a
  * about 200 of 840). The same set of samples as vpdsi_bgrid_near_packed, in another order. */
 size_t vpdsi_bgrid_slide(const vpdsi_bgrid *g, const double *x, uint64_t at, int32_t *out,
                          double *px, uint16_t *tag, size_t n);
-/* The first sample within reach of y (strictly nearer), or -1; x holds the samples' points. */
-int32_t vpdsi_bgrid_conflict(const vpdsi_bgrid *g, const double *x, const double *y, double reach);
+/* The first sample within reach of y (strictly nearer), or -1; x holds the samples' points, at
+ * is y's cell (vpdsi_bgrid_locate). */
+int32_t vpdsi_bgrid_conflict(const vpdsi_bgrid *g, const double *x, uint64_t at, const double *y, double reach);
 #endif

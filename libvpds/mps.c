@@ -54,12 +54,14 @@ void vpdsi_mps_release(vpdsi_mps *m, vpdsi_store *st)
     vpdsi_mem_free(st->mem, m->buf_x, m->cap_buf_x * sizeof(double));
     vpdsi_mem_free(st->mem, m->buf_r, m->cap_buf_r * sizeof(double));
     vpdsi_mem_free(st->mem, m->buf_u, m->cap_buf_u * sizeof(double));
+    vpdsi_mem_free(st->mem, m->buf_at, m->cap_buf_at * sizeof(uint64_t));
     vpdsi_uncovered_release(&m->unc, st->mem);
     m->cand = NULL;
     m->cand_x = NULL;
     m->cand_tag = NULL;
     m->buf_x = m->buf_r = m->buf_u = NULL;
-    m->cap_cand_tag = 0;
+    m->buf_at = NULL;
+    m->cap_cand_tag = m->cap_buf_at = 0;
     m->cap_cand = m->cap_cand_x = m->cap_buf_x = m->cap_buf_r = m->cap_buf_u = 0;
 }
 
@@ -298,11 +300,13 @@ static vpds_status prepare_darts(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, i
     size_t j;
     if ((e = reserve_buffers(m, ctx, n)) != VPDS_OK) return e;
     if ((e = vpdsi_store_reserve(st, n)) != VPDS_OK) return e;
-    if (weighted && vpdsi_mem_reserve(ctx->mem, (void **)&m->buf_u, &m->cap_buf_u, n, sizeof(double))) {
+    if ((weighted && vpdsi_mem_reserve(ctx->mem, (void **)&m->buf_u, &m->cap_buf_u, n, sizeof(double))) ||
+        (st->grid_mode && vpdsi_mem_reserve(ctx->mem, (void **)&m->buf_at, &m->cap_buf_at, n, sizeof(uint64_t)))) {
         vpdsi_store_error(st, "out of memory for a chunk of %zu darts", n);
         return VPDS_ERR_OUT_OF_MEMORY;
     }
     draw_darts(m, ctx, ctx->rng, n, m->buf_x, weighted ? m->buf_u : NULL);
+    for (j = 0; st->grid_mode && j < n; j++) m->buf_at[j] = vpdsi_bgrid_locate(&st->grid, m->buf_x + j * (size_t)d);
     if (st->sizing.kind == VPDSI_SIZING_CONSTANT) {
         for (j = 0; j < n; j++) m->buf_r[j] = st->sizing.radius;
     } else if ((e = vpdsi_store_radii(st, m->buf_x, n, m->buf_r)) != VPDS_OK) {
@@ -328,7 +332,7 @@ static vpds_status prepare_darts(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, i
 /* Whether the dart y (radius ry) becomes a sample (Eq. 4): it conflicts with no sample, lies
  * in the domain and, with two radii, covers a point not yet covered (Section 3.1, first
  * option). */
-static vpds_status judge_dart(vpdsi_mps *m, const vpdsi_ctx *ctx, const double *y, double ry,
+static vpds_status judge_dart(vpdsi_mps *m, const vpdsi_ctx *ctx, const double *y, uint64_t at, double ry,
                               int *accept)
 {
     const vpdsi_problem *pb = ctx->pb;
@@ -339,7 +343,7 @@ static vpds_status judge_dart(vpdsi_mps *m, const vpdsi_ctx *ctx, const double *
     vpds_status e;
     *accept = 0;
     if (st->grid_mode) {
-        hit = vpdsi_bgrid_conflict(&st->grid, st->x, y, scale * st->sizing.radius);
+        hit = vpdsi_bgrid_conflict(&st->grid, st->x, at, y, scale * st->sizing.radius);
     } else {
         hit = vpdsi_store_conflict(st, y, ry, (int)pb->rule, scale,
                                    varying ? st->sizing.lipschitz : -1.0, &witness);
@@ -365,6 +369,16 @@ static vpds_status judge_dart(vpdsi_mps *m, const vpdsi_ctx *ctx, const double *
 #ifndef DART_PREFETCH
 #define DART_PREFETCH 8 /* darts ahead whose cells and samples are asked for (vpdsi_store_prefetch) */
 #endif
+/* Dart j of the chunk asked for (vpdsi_store_prefetch; the background grid's with its cell). */
+static void prefetch_dart(const vpdsi_mps *m, const vpdsi_ctx *ctx, size_t j, int grid, int stage)
+{
+    const vpdsi_store *st = ctx->st;
+    if (grid)
+        vpdsi_bgrid_prefetch(&st->grid, st->x, m->buf_at[j], stage);
+    else
+        vpdsi_store_prefetch(st, m->buf_x + j * (size_t)ctx->pb->dim, m->buf_r[j], stage);
+}
+
 static vpds_status darts_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
 {
     vpdsi_store *st = ctx->st;
@@ -373,16 +387,17 @@ static vpds_status darts_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
     vpds_status e;
     size_t j;
     uint64_t boxes0 = m->unc.boxes;
+    int grid = st->grid_mode; /* its cells located by prepare_darts */
     if ((e = prepare_darts(m, ctx, n, weighted)) != VPDS_OK) return e;
     for (j = 0; j < n; j++) {
         const double *y = m->buf_x + j * (size_t)ctx->pb->dim;
         int accept;
         if (j + 2 * DART_PREFETCH < n)
-            vpdsi_store_prefetch(st, y + 2 * DART_PREFETCH * (size_t)ctx->pb->dim, m->buf_r[j + 2 * DART_PREFETCH], 0);
+            prefetch_dart(m, ctx, j + 2 * DART_PREFETCH, grid, 0);
         if (j + DART_PREFETCH < n)
-            vpdsi_store_prefetch(st, y + DART_PREFETCH * (size_t)ctx->pb->dim, m->buf_r[j + DART_PREFETCH], 1);
+            prefetch_dart(m, ctx, j + DART_PREFETCH, grid, 1);
         if (weighted && m->buf_u[j] == 0.0) continue;
-        if ((e = judge_dart(m, ctx, y, m->buf_r[j], &accept)) != VPDS_OK) {
+        if ((e = judge_dart(m, ctx, y, grid ? m->buf_at[j] : 0, m->buf_r[j], &accept)) != VPDS_OK) {
             /* keep the darts before this one, as a pause would */
             keep_darts_before(m, ctx, &start, j, weighted);
             return e;

@@ -48,6 +48,8 @@ typedef struct vpdsi_mps {
     double *buf_x; size_t cap_buf_x;        /* a chunk's darts or cell centres */
     double *buf_r; size_t cap_buf_r;        /* r there */
     double *buf_u; size_t cap_buf_u;        /* weighted mode: the acceptance draw of each dart */
+    uint64_t *buf_at; size_t cap_buf_at;    /* background grid: each dart's cell, located once
+                                               for its two prefetches and its test */
     vpdsi_uncovered unc;                    /* two radii */
     vpdsi_near_list strip, base;            /* the samples near the cells being swept (the
                                                background grid: base's key and store_n name

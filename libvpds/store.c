@@ -190,9 +190,7 @@ int32_t vpdsi_store_conflict(const vpdsi_store *st, const double *y, double ry, 
 
 void vpdsi_store_prefetch(const vpdsi_store *st, const double *y, double ry, int stage)
 {
-    if (st->grid_mode) {
-        vpdsi_bgrid_prefetch(&st->grid, st->x, y, stage);
-    } else if (st->ogrid_mode) {
+    if (st->ogrid_mode) {
         vpdsi_kd_samples v = vpdsi_store_view(st);
         vpdsi_ogrid_prefetch(&st->ogrid, &v, y, ry, stage);
     }

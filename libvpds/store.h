@@ -76,8 +76,9 @@ int vpdsi_store_gather(const vpdsi_store *st, const double *lo, const double *hi
                        int rule, double scale, int split, int32_t **out, size_t *count,
                        size_t *cap);
 /* Ask the caches for what a conflict query at y (radius ry) will read, a few queries ahead
- * (stage 0 the index's cells, stage 1 their samples: vpdsi_bgrid_prefetch,
- * vpdsi_ogrid_prefetch); nothing with the kd-tree. Changes nothing. */
+ * (stage 0 the index's cells, stage 1 their samples: vpdsi_ogrid_prefetch); nothing with the
+ * kd-tree, nor with the background grid, whose callers know the query's cell
+ * (vpdsi_bgrid_prefetch). Changes nothing. */
 void vpdsi_store_prefetch(const vpdsi_store *st, const double *y, double ry, int stage);
 /* vpdsi_kd_near_box without a limit on the index in use (kd-tree or octave grid): every sample
  * near the box [lo, hi] appended to *out; VPDS_ERR_OUT_OF_MEMORY said in the sink. */
