@@ -308,6 +308,15 @@ size_t vpdsi_bgrid_slide(const vpdsi_bgrid *g, const double *x, uint64_t at, int
     return kept;
 }
 
+void vpdsi_bgrid_prefetch_slide(const vpdsi_bgrid *g, const double *x, uint64_t at)
+{
+    size_t r, d = (size_t)g->dim;
+    for (r = 0; r < g->n_rows; r++) {
+        int32_t i = g->cell[(int64_t)at + g->row[r] + g->row_w[r]];
+        if (i >= 0) VPDSI_PREFETCH(x + (size_t)i * d);
+    }
+}
+
 int32_t vpdsi_bgrid_conflict(const vpdsi_bgrid *g, const double *x, uint64_t at, const double *y, double reach)
 {
     const int32_t *cell = g->cell + at;

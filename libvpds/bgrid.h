@@ -78,6 +78,9 @@ size_t vpdsi_bgrid_near_packed(const vpdsi_bgrid *g, const double *x, uint64_t a
  * about 200 of 840). The same set of samples as vpdsi_bgrid_near_packed, in another order. */
 size_t vpdsi_bgrid_slide(const vpdsi_bgrid *g, const double *x, uint64_t at, int32_t *out,
                          double *px, uint16_t *tag, size_t n);
+/* Asks the caches for the points vpdsi_bgrid_slide(g, x, at, ...) will copy (the samples of
+ * the stencil's leading cells lie anywhere in x). A hint only: nothing changes. */
+void vpdsi_bgrid_prefetch_slide(const vpdsi_bgrid *g, const double *x, uint64_t at);
 /* The first sample within reach of y (strictly nearer), or -1; x holds the samples' points, at
  * is y's cell (vpdsi_bgrid_locate). */
 int32_t vpdsi_bgrid_conflict(const vpdsi_bgrid *g, const double *x, uint64_t at, const double *y, double reach);

@@ -802,7 +802,12 @@ static vpds_status gather_near(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_
                                                 m->cand_tag);
             m->base.key = at + 1;
             m->base.store_n = st->n;
+        } else {
+            return VPDS_OK;
         }
+        /* the next base cell's newcomers, in 2D (in 3D their rows cost more than they saved:
+         * 1.05x the time at 10^5 samples) */
+        if (pb->dim == 2) vpdsi_bgrid_prefetch_slide(&st->grid, st->x, at + 1);
         return VPDS_OK;
     }
     m->n_cand = 0;
