@@ -129,10 +129,16 @@ static void half_set(vpdsi_cells *c, size_t i, uint32_t v)
     memcpy((unsigned char *)c->words + i * sizeof v, &v, sizeof v);
 }
 
+void vpdsi_cells_truncate(vpdsi_cells *c, size_t count, size_t n_fam)
+{
+    c->count = count;
+    c->n_fam = n_fam;
+    c->seq_set = 0;
+}
+
 void vpdsi_cells_empty(vpdsi_cells *c, vpdsi_mem *m)
 {
-    c->count = c->n_fam = 0;
-    c->seq_set = 0;
+    vpdsi_cells_truncate(c, 0, 0);
     vpdsi_cells_shrink(c, m);
 }
 

@@ -54,6 +54,9 @@ int vpdsi_cells_reserve_families(vpdsi_cells *c, vpdsi_mem *m, size_t more, int 
 void vpdsi_cells_push_family(vpdsi_cells *c, int dim, const uint64_t *parent, const uint64_t *children);
 /* The room past the cells held given back (a level's cells, once its sweep made them all). */
 void vpdsi_cells_shrink(vpdsi_cells *c, vpdsi_mem *m);
+/* Cut back to the first `count` cells and `n_fam` families (a sweep's retry after an error:
+ * what it held before the failed cell); the reading cursor of get_seq starts over. */
+void vpdsi_cells_truncate(vpdsi_cells *c, size_t count, size_t n_fam);
 /* Empty the array and give back its room as a shrink does: through realloc, which keeps a
  * large block mapped (a free would raise glibc's mmap threshold, and the blocks that follow
  * would come from the heap, which keeps their pages: 19 MiB more at the ramp's peak). */

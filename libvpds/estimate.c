@@ -22,11 +22,14 @@ static double jamming_density(int d)
 }
 
 /* Most active cells per base cell, measured with vpds_stats.peak_active_cells on uniform runs
- * of 10^3-10^5 samples (2D: level 0 counted whole; 6D and 7D with algorithm version 12, whose
- * pairs of disks drop cells: 2.8-5.9 in 6D, 4.5 in 7D); past 8D doubled per axis. */
-static double cells_per_base_cell(int d)
+ * of 10^3-10^5 samples (2D: level 0 counted whole); past 8D doubled per axis. From version 12
+ * on, pairs of disks drop cells from 6D (pencil.h): 2.8-5.9 in 6D, 4.5-12.2 in 7D, where
+ * version 11 held up to 11 and 20. */
+static double cells_per_base_cell(int d, unsigned algorithm)
 {
-    static const double c[9] = {0, 1, 1, 1.5, 4, 10, 6, 8, 32};
+    static const double c[9] = {0, 1, 1, 1.5, 4, 10, 11, 20, 32};
+    if (algorithm >= 12 && d == 6) return 6;
+    if (algorithm >= 12 && d == 7) return 10;
     return d <= 8 ? c[d] : c[8] * pow(2, d - 8);
 }
 
@@ -147,7 +150,7 @@ vpds_status vpdsi_estimate_run(const vpdsi_problem *pb, vpdsi_store *st, vpdsi_d
     out->samples = jamming_density(d) * volume * sums.inv_ball / PROBES *
                    pow(pb->coverage / pb->inhibition, d / 5.0) * face_factor(pb, sums.inv_cell);
     out->base_cells = base;
-    out->cells = cells_per_base_cell(d) * cells;
+    out->cells = cells_per_base_cell(d, pb->algorithm) * cells;
     out->bytes = bytes_per_cell(pb, side) * out->cells + bytes_per_sample(d) * out->samples;
     /* two radii keep the index of the uncovered region, a domain the cells along its boundary:
      * about as much again each, measured */

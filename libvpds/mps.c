@@ -976,8 +976,7 @@ static vpds_status sweep_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t
     if (pb->two_radii) whole_c = box_covered(m, ctx, lo, hi, r_lo, run->t * pb->coverage);
     for (block = 0; block < blocks; block++) {
         if ((e = sweep_block(m, ctx, c, split, block, r_lo, centre, phi, h, whole_c, pre)) != VPDS_OK) {
-            run->next.count = kept;
-            run->next.n_fam = kept_fam;
+            vpdsi_cells_truncate(&run->next, kept, kept_fam);
             m->unc.n_nwit = records;
             return e;
         }

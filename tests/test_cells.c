@@ -110,6 +110,10 @@ static void check_families(int d, unsigned level, size_t parents)
             }
         }
         CHECK_MSG(c.count == n, "dim %d: %zu cells held, %zu pushed", d, c.count, n);
+        if (pass && cut_n + 1 < n) { /* the cursor was in a family cut away: it starts over */
+            vpdsi_cells_get_seq(&c, cut_n + 1, d, got);
+            same &= memcmp(got, flat + (cut_n + 1) * (size_t)d, (size_t)d * sizeof *got) == 0;
+        }
         for (i = 0; i < n; i++) {
             vpdsi_cells_get_seq(&c, i, d, got);
             same &= memcmp(got, flat + i * (size_t)d, (size_t)d * sizeof *got) == 0;
@@ -122,8 +126,8 @@ static void check_families(int d, unsigned level, size_t parents)
             same &= memcmp(got, flat + at * (size_t)d, (size_t)d * sizeof *got) == 0;
         }
         if (!pass) { /* the cut: the families after it are pushed again, others this time */
-            c.count = cut_n;
-            c.n_fam = cut_fam;
+            if (cut_n < n) vpdsi_cells_get_seq(&c, cut_n, d, got);
+            vpdsi_cells_truncate(&c, cut_n, cut_fam);
             n = cut_n;
         }
     }
