@@ -79,7 +79,8 @@ size_t vpdsi_bgrid_near_packed(const vpdsi_bgrid *g, const double *x, uint64_t a
 size_t vpdsi_bgrid_slide(const vpdsi_bgrid *g, const double *x, uint64_t at, int32_t *out,
                          double *px, uint16_t *tag, size_t n);
 /* Asks the caches for the points vpdsi_bgrid_slide(g, x, at, ...) will copy (the samples of
- * the stencil's leading cells lie anywhere in x). A hint only: nothing changes. */
+ * the stencil's leading cells lie anywhere in x); at must be a base cell's, as for the slide.
+ * A hint only: nothing changes. */
 void vpdsi_bgrid_prefetch_slide(const vpdsi_bgrid *g, const double *x, uint64_t at);
 /* The first sample within reach of y (strictly nearer), or -1; x holds the samples' points, at
  * is y's cell (vpdsi_bgrid_locate). */

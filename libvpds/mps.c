@@ -806,8 +806,9 @@ static vpds_status gather_near(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_
             return VPDS_OK;
         }
         /* the next base cell's newcomers, in 2D (in 3D their rows cost more than they saved:
-         * 1.05x the time at 10^5 samples) */
-        if (pb->dim == 2) vpdsi_bgrid_prefetch_slide(&st->grid, st->x, at + 1);
+         * 1.05x the time at 10^5 samples), when it lies on this row: past its end the
+         * stencil's leading cells would lie past the grid's border */
+        if (pb->dim == 2 && base[0] + 1 < st->grid.n[0]) vpdsi_bgrid_prefetch_slide(&st->grid, st->x, at + 1);
         return VPDS_OK;
     }
     m->n_cand = 0;
