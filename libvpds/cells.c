@@ -21,6 +21,15 @@ double vpdsi_lattice_box(const vpdsi_lattice *g, unsigned level, const uint64_t 
     return diag2;
 }
 
+void vpdsi_lattice_mid(const vpdsi_lattice *g, unsigned level, const uint64_t *c, double *mid)
+{
+    uint64_t bits = (uint64_t)(1023 - (level + 1)) << 52; /* as vpdsi_lattice_box, a level down */
+    double shrink;
+    int k;
+    memcpy(&shrink, &bits, sizeof shrink);
+    for (k = 0; k < g->dim; k++) mid[k] = g->lo[k] + (double)(2 * c[k] + 1) * (g->side0[k] * shrink);
+}
+
 double vpdsi_lattice_base_side(double reach, int dim) { return reach / sqrt((double)dim) * (1 - 1e-9); }
 
 double vpdsi_lattice_base_count(int dim, const double *lo, const double *hi, double side)

@@ -88,6 +88,10 @@ typedef struct vpdsi_lattice {
  * at the box's face); returns the squared diagonal. */
 double vpdsi_lattice_box(const vpdsi_lattice *g, unsigned level, const uint64_t *c, double *lo,
                          double *hi);
+/* Where the cell's halves meet on each axis: the children's boxes at level + 1 are [lo, mid]
+ * and [mid, hi], the same bits as vpdsi_lattice_box gives them (its box at `level` is theirs
+ * joined: scaling by 2 is exact). */
+void vpdsi_lattice_mid(const vpdsi_lattice *g, unsigned level, const uint64_t *c, double *mid);
 
 /* Side of the base cells of a run whose largest disk reaches `reach` (t * coverage * r_max):
  * a diagonal just under it, so that a sample covers a cell of its own size. */

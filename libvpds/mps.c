@@ -578,18 +578,14 @@ static void children_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned 
  * on an axis the cell's farther end is the farther of its halves' (rounding is monotone), and
  * the sums run in the same order. A pass stops once every child is covered: a later disk
  * holding the whole cell would leave no child either. */
-static int packed_cover(const vpdsi_mps *m, int d, unsigned level, const uint64_t *c, double f,
-                        uint64_t *covered)
+static int packed_cover(const vpdsi_mps *m, int d, unsigned level, const uint64_t *c, const double *lo,
+                        const double *hi, double f, uint64_t *covered)
 {
     unsigned children = 1u << d;
-    double lo[VPDS_MAX_DIM], mid[VPDS_MAX_DIM], hi[VPDS_MAX_DIM], f2 = f * f;
-    uint64_t cc[VPDS_MAX_DIM] = {0};
+    double mid[VPDS_MAX_DIM], f2 = f * f;
     size_t j;
     int k;
-    for (k = 0; k < d; k++) cc[k] = 2 * c[k];
-    vpdsi_lattice_box(&m->run.geom, level + 1, cc, lo, mid);
-    for (k = 0; k < d; k++) cc[k] = 2 * c[k] + 1;
-    vpdsi_lattice_box(&m->run.geom, level + 1, cc, mid, hi);
+    vpdsi_lattice_mid(&m->run.geom, level, c, mid); /* the children: [lo, mid] and [mid, hi] */
     if (!(f > 0)) return 0;
     for (j = 0; j < m->n_cand; j++) {
         const double *x = m->cand_x + j * (size_t)d;
@@ -966,7 +962,7 @@ static vpds_status sweep_cell(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t
     if (holder_covers(m, ctx, lo, hi, r_lo, r_hi, scale, split)) return VPDS_OK;
     if ((e = gather_near(m, ctx, c, level, lo, hi, r_hi, split)) != VPDS_OK) return e;
     if (st->grid_mode && split) { /* one radius, open axes, one block: one pass decides all */
-        if (packed_cover(m, d, level, c, scale * st->sizing.radius, known)) return VPDS_OK;
+        if (packed_cover(m, d, level, c, lo, hi, scale * st->sizing.radius, known)) return VPDS_OK;
         pre = known;
     } else if (uses_pencil(ctx)) {
         if (box_held(m, ctx, lo, hi, r_lo, scale)) return VPDS_OK;
