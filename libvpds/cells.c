@@ -81,7 +81,12 @@ void vpdsi_cells_layout_families(vpdsi_cells *c, int dim, const uint64_t *n0, un
     c->level = level;
     c->families = 1;
     c->mask_bytes = dim > 3 ? 1u << (dim - 3) : 1u;
-    c->fam_bytes = c->mask_bytes + (c->words_per_cell == 0 ? 4u : 8u * c->words_per_cell);
+    c->fam_bytes = vpdsi_cells_family_bytes(dim, c->words_per_cell == 0 ? 32u : 64u * c->words_per_cell);
+}
+
+unsigned vpdsi_cells_family_bytes(int dim, unsigned parent_bits)
+{
+    return (dim > 3 ? 1u << (dim - 3) : 1u) + (parent_bits <= 32 ? 4u : 8u * ((parent_bits + 63) / 64));
 }
 
 /* 64-bit words that n records take (0 when the size overflows). */
@@ -311,7 +316,8 @@ static size_t bucket_first(const vpdsi_cells *c, size_t i)
 
 /* Cell i of families, from family f whose first cell is first (<= i): its family the one whose
  * cells reach past i, its child b the (i - first)-th set bit of the family's mask. */
-static size_t family_get(const vpdsi_cells *c, size_t i, size_t *f_io, size_t first, int dim, uint64_t *coord)
+static size_t family_get(const vpdsi_cells *c, size_t i, size_t *f_io, size_t first, int dim, uint64_t *coord,
+                         unsigned *b_out)
 {
     size_t f = *f_io;
     unsigned n, w, b = 0;
@@ -331,6 +337,7 @@ static size_t family_get(const vpdsi_cells *c, size_t i, size_t *f_io, size_t fi
     for (; n > 0; n--) word &= word - 1; /* clear the lowest n set bits */
     while (!((word >> b) & 1u)) b++;
     b += 64 * w;
+    *b_out = b;
     unpack_at(c, f, dim, coord);
     for (k = 0; k < dim; k++) coord[k] = 2 * coord[k] + ((b >> k) & 1u);
     return first;
@@ -339,12 +346,13 @@ static size_t family_get(const vpdsi_cells *c, size_t i, size_t *f_io, size_t fi
 void vpdsi_cells_get(const vpdsi_cells *c, size_t i, int dim, uint64_t *coord)
 {
     size_t f;
+    unsigned b;
     if (!c->families) {
         unpack_at(c, i, dim, coord);
         return;
     }
     f = c->bucket_fam[i >> VPDSI_CELLS_BUCKET_SHIFT];
-    (void)family_get(c, i, &f, bucket_first(c, i), dim, coord);
+    (void)family_get(c, i, &f, bucket_first(c, i), dim, coord, &b);
 }
 
 /* Index of the lowest set bit of x (non-zero): de Bruijn, portable. */
@@ -393,13 +401,10 @@ void vpdsi_cells_get_seq(vpdsi_cells *c, size_t i, int dim, uint64_t *coord)
     if (c->seq_set && i == c->seq_i + 1) {
         seq_step(c, dim);
     } else { /* from the bucket of cell i */
-        size_t j = i >> VPDSI_CELLS_BUCKET_SHIFT, f = c->bucket_fam[j], at;
-        int b;
-        c->seq_first = family_get(c, i, &f, bucket_first(c, i), dim, coord);
+        size_t f = c->bucket_fam[i >> VPDSI_CELLS_BUCKET_SHIFT];
+        c->seq_first = family_get(c, i, &f, bucket_first(c, i), dim, coord, &c->seq_b);
         c->seq_f = f;
         unpack_at(c, f, dim, c->seq_parent);
-        for (at = c->seq_first, b = next_child(c, f, 0); at < i; at++) b = next_child(c, f, (unsigned)b + 1);
-        c->seq_b = (unsigned)b;
         c->seq_set = 1;
     }
     c->seq_i = i;

@@ -45,6 +45,9 @@ int vpdsi_cells_reserve(vpdsi_cells *c, vpdsi_mem *m, size_t cells);
  * cells, little saved for 1.18x the time) to 8D (past it children come in blocks); the two
  * radii keep a flag per child. */
 int vpdsi_cells_families_serve(int dim, int two_radii);
+/* Bytes of a family's record: its mask (2^dim bits, a byte at least), then its parent's
+ * coordinates in parent_bits bits packed as a level packs them (4 bytes, or 64-bit words). */
+unsigned vpdsi_cells_family_bytes(int dim, unsigned parent_bits);
 /* Empty the array and lay it out as families (above) for cells at `level` >= 1 (dim <= 8). */
 void vpdsi_cells_layout_families(vpdsi_cells *c, int dim, const uint64_t *n0, unsigned level);
 /* Room for `more` families with all their children. */

@@ -46,16 +46,15 @@ static double cells_per_base_cell(int d, unsigned algorithm)
  * 0.9 2^(d/2)), and a bucket entry of 9 bytes per 64 cells. */
 static double bytes_per_cell(const vpdsi_problem *pb, double side)
 {
-    double bits = 0, parent_bytes, record_bytes;
+    double bits = 0;
     int k;
     for (k = 0; k < pb->dim; k++) /* cells.c's layout: the bits of n0, plus one per level */
         bits += vpdsi_bit_length((uint64_t)ceil((pb->hi[k] - pb->lo[k]) / side)) + 2;
     if (!vpdsi_cells_families_serve(pb->dim, pb->two_radii))
         return bits <= 32 ? BYTES_PER_CELL_WORD / 2 : BYTES_PER_CELL_WORD * ceil(bits / 64);
     bits -= pb->dim; /* the parents' level */
-    parent_bytes = bits <= 32 ? 4 : 8 * ceil(bits / 64);
-    record_bytes = (pb->dim > 3 ? (double)(1u << (pb->dim - 3)) : 1.0) + parent_bytes;
-    return BYTES_PER_CELL_WORD / 8 * (record_bytes / (0.9 * pow(2, pb->dim / 2.0)) + 9.0 / 64);
+    return BYTES_PER_CELL_WORD / 8 *
+           (vpdsi_cells_family_bytes(pb->dim, (unsigned)bits) / (0.9 * pow(2, pb->dim / 2.0)) + 9.0 / 64);
 }
 
 static double bytes_per_sample(int d)

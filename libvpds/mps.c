@@ -540,12 +540,9 @@ static void children_covered(const vpdsi_mps *m, const vpdsi_ctx *ctx, unsigned 
     vpdsi_store *st = ctx->st;
     int d = pb->dim, k, low = d < BLOCK_BITS ? d : BLOCK_BITS;
     double lo[VPDS_MAX_DIM], mid[VPDS_MAX_DIM], hi[VPDS_MAX_DIM];
-    uint64_t cc[VPDS_MAX_DIM] = {0};
     size_t j;
-    for (k = 0; k < d; k++) cc[k] = 2 * c[k];
-    vpdsi_lattice_box(&m->run.geom, level + 1, cc, lo, mid);
-    for (k = 0; k < d; k++) cc[k] = 2 * c[k] + 1;
-    vpdsi_lattice_box(&m->run.geom, level + 1, cc, mid, hi);
+    vpdsi_lattice_box(&m->run.geom, level, c, lo, hi);
+    vpdsi_lattice_mid(&m->run.geom, level, c, mid); /* the children: [lo, mid] and [mid, hi] */
     if (pen) vpdsi_pencil_reset(pen, d, lo, hi);
     for (j = 0; j < m->n_cand; j++) {
         const double *x = st->x + (size_t)m->cand[j] * (size_t)d;
