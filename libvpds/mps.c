@@ -419,7 +419,7 @@ static vpds_status darts_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n)
 
 /* Version 12, on the kd-tree's lists from 6D on: a cell or child that two disks hold together
  * is dropped as one that one disk holds (pencil.h). Below 6D it cost more than it saved
- * (README, performance); the background grid and the octave grid do without it. */
+ * (docs/performance-log.md); the background grid and the octave grid do without it. */
 #ifndef VPDSI_PENCIL_MIN_DIM
 #define VPDSI_PENCIL_MIN_DIM 6
 #endif
