@@ -68,6 +68,7 @@ void vpdsi_cells_layout(vpdsi_cells *c, int dim, const uint64_t *n0, unsigned le
     c->families = 0;
     c->n_fam = 0;
     c->seq_set = 0;
+    c->reversed = 0;
 }
 
 int vpdsi_cells_families_serve(int dim, int two_radii)
@@ -148,6 +149,64 @@ void vpdsi_cells_truncate(vpdsi_cells *c, size_t count, size_t n_fam)
     c->count = count;
     c->n_fam = n_fam;
     c->seq_set = 0;
+    c->reversed = 0;
+}
+
+/* Where flat cell i, or with families record i, lies. */
+static size_t place(const vpdsi_cells *c, size_t i) { return c->reversed ? c->rev_top - i : i; }
+
+/* Family f's record: its mask, then its parent's coordinates. */
+static const uint8_t *record(const vpdsi_cells *c, size_t f) { return c->fam + place(c, f) * c->fam_bytes; }
+
+static void swap_bytes(uint8_t *a, uint8_t *b, size_t n)
+{
+    size_t k;
+    for (k = 0; k < n; k++) {
+        uint8_t t = a[k];
+        a[k] = b[k];
+        b[k] = t;
+    }
+}
+
+void vpdsi_cells_reverse(vpdsi_cells *c)
+{
+    size_t a, b, n = c->families ? c->n_fam : c->count;
+    if (c->reversed || n == 0) return;
+    for (a = 0, b = n - 1; a < b; a++, b--) {
+        if (c->families) {
+            swap_bytes(c->fam + a * c->fam_bytes, c->fam + b * c->fam_bytes, c->fam_bytes);
+        } else if (c->words_per_cell == 0) {
+            uint32_t t = half_get(c, a);
+            half_set(c, a, half_get(c, b));
+            half_set(c, b, t);
+        } else {
+            uint64_t t[VPDSI_CELLS_MAX_WORDS];
+            size_t n = c->words_per_cell * sizeof *t;
+            memcpy(t, c->words + a * c->words_per_cell, n);
+            memcpy(c->words + a * c->words_per_cell, c->words + b * c->words_per_cell, n);
+            memcpy(c->words + b * c->words_per_cell, t, n);
+        }
+    }
+    c->reversed = 1;
+    c->rev_top = n - 1;
+}
+
+void vpdsi_cells_give_back_read(vpdsi_cells *c, vpdsi_mem *m, size_t read)
+{
+    size_t keep;
+    if (!c->reversed || read > c->count) return;
+    if (c->families) {
+        /* the families from the one holding the first cell of the bucket of cell read - 1 (a
+         * cell past it is found from there, and get_seq's next step reads the family of the
+         * cell it read last): places 0 .. n_fam - 1 - that family */
+        if (read == 0) return;
+        keep = (c->n_fam - c->bucket_fam[(read - 1) >> VPDSI_CELLS_BUCKET_SHIFT]) * c->fam_bytes;
+        if (keep <= c->cap_fam - (c->cap_fam >> 3)) vpdsi_mem_shrink(m, (void **)&c->fam, &c->cap_fam, keep, 1);
+        return;
+    }
+    keep = record_words(c, c->count - read); /* places 0 .. count - read - 1 */
+    if (keep <= c->cap_words - (c->cap_words >> 3))
+        vpdsi_mem_shrink(m, (void **)&c->words, &c->cap_words, keep, sizeof *c->words);
 }
 
 void vpdsi_cells_empty(vpdsi_cells *c, vpdsi_mem *m)
@@ -169,6 +228,7 @@ void vpdsi_cells_release(vpdsi_cells *c, vpdsi_mem *m)
     c->cap_words = c->cap_fam = c->cap_bucket_fam = c->cap_bucket_off = 0;
     c->count = c->n_fam = 0;
     c->seq_set = 0;
+    c->reversed = 0;
 }
 
 static void unpack_at(const vpdsi_cells *c, size_t i, int dim, uint64_t *coord);
@@ -208,7 +268,7 @@ static unsigned popcount64(uint64_t x)
  * (native byte order: the masks never leave the process). */
 static uint64_t mask_word(const vpdsi_cells *c, size_t f, unsigned w)
 {
-    const uint8_t *p = c->fam + f * c->fam_bytes;
+    const uint8_t *p = record(c, f);
     uint16_t v2;
     uint32_t v4;
     uint64_t v8;
@@ -236,7 +296,7 @@ static const uint8_t byte_bits[256] = {
 static unsigned family_size(const vpdsi_cells *c, size_t f)
 {
     unsigned w, n = 0;
-    if (c->mask_bytes == 1) return byte_bits[c->fam[f * c->fam_bytes]];
+    if (c->mask_bytes == 1) return byte_bits[record(c, f)[0]];
     for (w = 0; w < mask_words(c); w++) n += popcount64(mask_word(c, f, w));
     return n;
 }
@@ -298,13 +358,13 @@ void vpdsi_cells_prefetch(const vpdsi_cells *c, size_t i)
 {
     if (c->families) { /* the bucket is read (a small array), its family asked for */
         size_t f = c->bucket_fam[i >> VPDSI_CELLS_BUCKET_SHIFT];
-        VPDSI_PREFETCH(c->fam + f * c->fam_bytes);
+        VPDSI_PREFETCH(record(c, f));
         return;
     }
     if (c->words_per_cell == 0)
-        VPDSI_PREFETCH((const unsigned char *)c->words + i * sizeof(uint32_t));
+        VPDSI_PREFETCH((const unsigned char *)c->words + place(c, i) * sizeof(uint32_t));
     else
-        VPDSI_PREFETCH(c->words + i * c->words_per_cell);
+        VPDSI_PREFETCH(c->words + place(c, i) * c->words_per_cell);
 }
 
 /* The first cell of the family holding the first cell of cell i's bucket. */
@@ -433,7 +493,7 @@ static void unpack_at(const vpdsi_cells *c, size_t i, int dim, uint64_t *coord)
 {
     uint64_t w[VPDSI_CELLS_MAX_WORDS];
     if (c->families) {
-        const uint8_t *p = c->fam + i * c->fam_bytes + c->mask_bytes;
+        const uint8_t *p = record(c, i) + c->mask_bytes;
         if (c->words_per_cell == 0) {
             uint32_t v;
             memcpy(&v, p, 4);
@@ -443,9 +503,9 @@ static void unpack_at(const vpdsi_cells *c, size_t i, int dim, uint64_t *coord)
         }
         decode(c, w, dim, coord);
     } else if (c->words_per_cell == 0) {
-        w[0] = half_get(c, i);
+        w[0] = half_get(c, place(c, i));
         decode(c, w, dim, coord);
     } else {
-        decode(c, c->words + i * c->words_per_cell, dim, coord);
+        decode(c, c->words + place(c, i) * c->words_per_cell, dim, coord);
     }
 }

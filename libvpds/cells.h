@@ -25,6 +25,10 @@ typedef struct vpdsi_cells {
     uint8_t *fam; size_t cap_fam;
     uint64_t *bucket_fam; size_t cap_bucket_fam;
     uint8_t *bucket_off; size_t cap_bucket_off;
+    /* stored back to front (vpdsi_cells_reverse): flat cell i, or family record i, at place
+     * rev_top - i (the buckets stay as they are) */
+    int reversed;
+    size_t rev_top;
     /* vpdsi_cells_get_seq's last read: cell seq_i, child seq_b of family seq_f (whose first
      * cell is seq_first and whose coordinates are seq_parent) */
     size_t seq_i, seq_f, seq_first;
@@ -65,6 +69,16 @@ void vpdsi_cells_truncate(vpdsi_cells *c, size_t count, size_t n_fam);
  * would come from the heap, which keeps their pages: 19 MiB more at the ramp's peak). */
 void vpdsi_cells_empty(vpdsi_cells *c, vpdsi_mem *m);
 void vpdsi_cells_release(vpdsi_cells *c, vpdsi_mem *m);
+/* Store the cells (flat) or the family records back to front, each at the same index: a sweep
+ * that reads them in order then gives back the room of those it has read
+ * (vpdsi_cells_give_back_read), so that its peak holds little more than the larger of the two
+ * levels where it held both whole (the run's peak). Only get, get_seq, prefetch and
+ * give_back_read read a reversed array; truncate, empty and layout make it a plain one again. */
+void vpdsi_cells_reverse(vpdsi_cells *c);
+/* The room of cells 0 .. read - 1 of a reversed array given back through realloc (with
+ * families, of those before the family of the first cell of the bucket of cell read - 1),
+ * an eighth of it at a time (none by an allocator without realloc, or when it refuses). */
+void vpdsi_cells_give_back_read(vpdsi_cells *c, vpdsi_mem *m, size_t read);
 /* Append (after reserve; never allocates) and read back. */
 void vpdsi_cells_push(vpdsi_cells *c, int dim, const uint64_t *coord);
 void vpdsi_cells_get(const vpdsi_cells *c, size_t i, int dim, uint64_t *coord);

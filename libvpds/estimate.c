@@ -34,10 +34,11 @@ static double cells_per_base_cell(int d, unsigned algorithm)
 }
 
 /* Bytes per active cell and per 64-bit word of its bit-packed coordinates (the level's cells
- * and the next level's, with their growth), and per sample (coordinates, r, t, flags, kd-tree
- * and grid entries): fits of peak_bytes over 1D-11D runs. A cell whose coordinates fit 32 bits
- * takes half a word (cells.c). */
-#define BYTES_PER_CELL_WORD 16.0
+ * and the part of the next level's a sweep holds with them: it gives back the room of those it
+ * has read, cells.h), and per sample (coordinates, r, t, flags, kd-tree and grid entries): fits
+ * of peak_bytes over 1D-11D runs (12 per word since 2026-12-07; 16 when a sweep held both
+ * levels whole). A cell whose coordinates fit 32 bits takes half a word (cells.c). */
+#define BYTES_PER_CELL_WORD 12.0
 
 /* Bytes per active cell on the base grid of cells of side `side` over the box: its coordinates
  * at level 2, where runs hold the most cells, in 32 bits or in 64-bit words; kept as families

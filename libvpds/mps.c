@@ -1011,6 +1011,7 @@ static vpds_status sweep_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, int
         /* the coverage searches' boxes are work too: a budget bounds them */
         if (j + 1 + (m->unc.boxes - boxes0) >= n) break;
     }
+    if (!run->implicit) vpdsi_cells_give_back_read(&run->cur, ctx->mem, (size_t)run->pos);
     return VPDS_OK;
 }
 
@@ -1063,9 +1064,11 @@ static void finish_sweep(vpdsi_mps *m, const vpdsi_ctx *ctx, int split)
     vpdsi_cells tmp = run->cur;
     run->cur = run->next;
     run->next = tmp;
-    /* the next sweep holds these cells beside the ones it makes: the run's peak; the level
-     * before, emptied, gives its room back (held through the darts, it was larger than this
-     * one past the largest level) */
+    /* the next sweep holds these cells beside the ones it makes: the run's peak; stored back
+     * to front, they give back their room as it reads them. The level before, emptied, gives
+     * its room back (held through the darts, it was larger than this one past the largest
+     * level) */
+    vpdsi_cells_reverse(&run->cur);
     vpdsi_cells_shrink(&run->cur, ctx->mem);
     vpdsi_cells_empty(&run->next, ctx->mem);
     run->implicit = 0;

@@ -18,8 +18,46 @@ static uint64_t next_u64(void)
     return rng_state ^ (rng_state >> 29);
 }
 
+/* The n cells of c (copy) stored back to front (flat cells, or family records): each index
+ * reads the same cell, at random and in order, while a sweep's reading in order gives back the
+ * room of the cells it has read: in the end no more than an eighth of the room and a word are
+ * held, the allocator's count follows each step, and a cut makes it a plain array again. */
+static size_t reversed_room(const vpdsi_cells *c)
+{
+    return c->families ? c->cap_fam : c->cap_words * sizeof *c->words;
+}
+
+static void check_reversed(vpdsi_cells *c, vpdsi_mem *mem, int d, const uint64_t *copy, size_t n)
+{
+    uint64_t got[VPDS_MAX_DIM];
+    size_t i, start = reversed_room(c), other = mem->held - start, gave = 0;
+    int same = 1;
+    vpdsi_cells_reverse(c);
+    CHECK(c->reversed == (n > 0) && c->count == n);
+    for (i = 0; i < n; i++) {
+        size_t j = (size_t)(next_u64() % n);
+        vpdsi_cells_prefetch(c, j);
+        vpdsi_cells_get(c, j, d, got);
+        same &= memcmp(got, copy + j * d, (size_t)d * sizeof *got) == 0;
+    }
+    for (i = 0; i < n; i++) {
+        size_t before = reversed_room(c);
+        vpdsi_cells_get_seq(c, i, d, got);
+        same &= memcmp(got, copy + i * d, (size_t)d * sizeof *got) == 0;
+        vpdsi_cells_give_back_read(c, mem, i + 1);
+        gave += reversed_room(c) < before;
+        CHECK(mem->held == other + reversed_room(c));
+    }
+    CHECK_MSG(same, "dim %d: a cell read back from a reversed array differs (families %d)", d, c->families);
+    CHECK_MSG(reversed_room(c) <= start / 8 + 8 && (n < 64 || gave >= 8),
+              "dim %d: %zu of %zu bytes still held after reading %zu cells (%zu give-backs, families %d)", d,
+              reversed_room(c), start, n, gave, c->families);
+    vpdsi_cells_truncate(c, 0, 0);
+    CHECK(!c->reversed);
+}
+
 /* Lattice n0 (per axis) at `level`: push n random cells, read them back, keep every third by
- * moves, read again. */
+ * moves, read again, then stored back to front (check_reversed). */
 static void check_layout(int d, const uint64_t *n0, unsigned level, size_t n)
 {
     vpdsi_mem mem;
@@ -68,6 +106,7 @@ static void check_layout(int d, const uint64_t *n0, unsigned level, size_t n)
         same &= memcmp(got, copy + i * d, (size_t)d * sizeof *got) == 0;
     }
     CHECK_MSG(same, "dim %d, level %u, %u bits: a cell read back differs", d, level, bits);
+    check_reversed(&c, &mem, d, copy, kept);
     vpdsi_cells_release(&c, &mem);
     CHECK(mem.held == 0);
     free(copy);
@@ -75,7 +114,8 @@ static void check_layout(int d, const uint64_t *n0, unsigned level, size_t n)
 
 /* Families (cells.h) against the flat list of the same children, for d = 1..8 at random
  * levels: a sweep's order (vpdsi_cells_get_seq), a dart's (vpdsi_cells_get, random), a cut
- * back to an earlier family and pushed again (a sweep's retry after an error), a shrink. */
+ * back to an earlier family and pushed again (a sweep's retry after an error), a shrink, the
+ * records stored back to front (check_reversed). */
 static void check_families(int d, unsigned level, size_t parents)
 {
     vpdsi_mem mem;
@@ -140,6 +180,7 @@ static void check_families(int d, unsigned level, size_t parents)
     CHECK_MSG(same, "dim %d, level %u: a cell differs after a shrink", d, level);
     CHECK_MSG(c.cap_fam == c.n_fam * c.fam_bytes, "dim %d: %zu bytes held for %zu families of %u", d, c.cap_fam,
               c.n_fam, c.fam_bytes);
+    check_reversed(&c, &mem, d, flat, n);
     /* emptied (a level past its use): no cell, a byte of room each, and it fills again */
     vpdsi_cells_empty(&c, &mem);
     CHECK_MSG(c.count == 0 && c.n_fam == 0 && c.cap_fam == 1 && c.cap_bucket_fam == 1 && c.cap_bucket_off == 1 &&
