@@ -295,8 +295,12 @@ static const uint8_t byte_bits[256] = {
 
 static unsigned family_size(const vpdsi_cells *c, size_t f)
 {
+    const uint8_t *p = record(c, f);
     unsigned w, n = 0;
-    if (c->mask_bytes == 1) return byte_bits[record(c, f)[0]];
+    if (c->mask_bytes <= 8) { /* up to 6D a byte's count at a time: a dart's cell walks families */
+        for (w = 0; w < c->mask_bytes; w++) n += byte_bits[p[w]];
+        return n;
+    }
     for (w = 0; w < mask_words(c); w++) n += popcount64(mask_word(c, f, w));
     return n;
 }
