@@ -181,10 +181,10 @@ void vpdsi_cells_reverse(vpdsi_cells *c)
             half_set(c, b, t);
         } else {
             uint64_t t[VPDSI_CELLS_MAX_WORDS];
-            size_t n = c->words_per_cell * sizeof *t;
-            memcpy(t, c->words + a * c->words_per_cell, n);
-            memcpy(c->words + a * c->words_per_cell, c->words + b * c->words_per_cell, n);
-            memcpy(c->words + b * c->words_per_cell, t, n);
+            size_t bytes = c->words_per_cell * sizeof *t;
+            memcpy(t, c->words + a * c->words_per_cell, bytes);
+            memcpy(c->words + a * c->words_per_cell, c->words + b * c->words_per_cell, bytes);
+            memcpy(c->words + b * c->words_per_cell, t, bytes);
         }
     }
     c->reversed = 1;
