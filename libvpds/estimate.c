@@ -35,26 +35,28 @@ static double cells_per_base_cell(int d, unsigned algorithm)
 
 /* Bytes per active cell and per 64-bit word of its bit-packed coordinates (the level's cells
  * and the part of the next level's a sweep holds with them: it gives back the room of those it
- * has read, cells.h), and per sample (coordinates, r, t, flags, kd-tree and grid entries): fits
- * of peak_bytes over 1D-11D runs (12 per word since 2026-12-07; 16 when a sweep held both
- * levels whole). A cell whose coordinates fit 32 bits takes half a word (cells.c). */
+ * has read through realloc, cells.h; an allocator without realloc gets none back, and a sweep
+ * holds both levels whole), and per sample (coordinates, r, t, flags, kd-tree and grid
+ * entries): fits of peak_bytes over 1D-11D runs. A cell whose coordinates fit 32 bits takes
+ * half a word (cells.c). */
 #define BYTES_PER_CELL_WORD 12.0
+#define BYTES_PER_CELL_WORD_HELD 16.0
 
 /* Bytes per active cell on the base grid of cells of side `side` over the box: its coordinates
  * at level 2, where runs hold the most cells, in 32 bits or in 64-bit words; kept as families
  * (cells.h), a record per parent shared by its children (measured at level 2 with algorithm
  * version 12: 2.6 in 3D, 3.7 in 4D, 5.5 in 5D, 7.5 in 6D, 11.6 in 7D, 22 in 8D, about
  * 0.9 2^(d/2)), and a bucket entry of 9 bytes per 64 cells. */
-static double bytes_per_cell(const vpdsi_problem *pb, double side)
+static double bytes_per_cell(const vpdsi_problem *pb, double side, int gives_back)
 {
-    double bits = 0;
+    double bits = 0, word = gives_back ? BYTES_PER_CELL_WORD : BYTES_PER_CELL_WORD_HELD;
     int k;
     for (k = 0; k < pb->dim; k++) /* cells.c's layout: the bits of n0, plus one per level */
         bits += vpdsi_bit_length((uint64_t)ceil((pb->hi[k] - pb->lo[k]) / side)) + 2;
     if (!vpdsi_cells_families_serve(pb->dim, pb->two_radii))
-        return bits <= 32 ? BYTES_PER_CELL_WORD / 2 : BYTES_PER_CELL_WORD * ceil(bits / 64);
+        return bits <= 32 ? word / 2 : word * ceil(bits / 64);
     bits -= pb->dim; /* the parents' level */
-    return BYTES_PER_CELL_WORD / 8 *
+    return word / 8 *
            (vpdsi_cells_family_bytes(pb->dim, (unsigned)bits) / (0.9 * pow(2, pb->dim / 2.0)) + 9.0 / 64);
 }
 
@@ -151,7 +153,8 @@ vpds_status vpdsi_estimate_run(const vpdsi_problem *pb, vpdsi_store *st, vpdsi_d
                    pow(pb->coverage / pb->inhibition, d / 5.0) * face_factor(pb, sums.inv_cell);
     out->base_cells = base;
     out->cells = cells_per_base_cell(d, pb->algorithm) * cells;
-    out->bytes = bytes_per_cell(pb, side) * out->cells + bytes_per_sample(d) * out->samples;
+    out->bytes = bytes_per_cell(pb, side, st->mem->a.realloc != NULL) * out->cells +
+                 bytes_per_sample(d) * out->samples;
     /* two radii keep the index of the uncovered region, a domain the cells along its boundary:
      * about as much again each, measured */
     if (pb->two_radii) out->bytes *= 2;

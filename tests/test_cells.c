@@ -20,8 +20,10 @@ static uint64_t next_u64(void)
 
 /* The n cells of c (copy) stored back to front (flat cells, or family records): each index
  * reads the same cell, at random and in order, while a sweep's reading in order gives back the
- * room of the cells it has read: in the end no more than an eighth of the room and a word are
- * held, the allocator's count follows each step, and a cut makes it a plain array again. */
+ * room of the cells it has read, and the cells not read yet still read right from their
+ * buckets (a paused or retried sweep's reads): in the end no more than an eighth of the room
+ * and a word are held, the allocator's count follows each step, and a cut makes it a plain
+ * array again. */
 static size_t reversed_room(const vpdsi_cells *c)
 {
     return c->families ? c->cap_fam : c->cap_words * sizeof *c->words;
@@ -47,6 +49,13 @@ static void check_reversed(vpdsi_cells *c, vpdsi_mem *mem, int d, const uint64_t
         vpdsi_cells_give_back_read(c, mem, i + 1);
         gave += reversed_room(c) < before;
         CHECK(mem->held == other + reversed_room(c));
+        if (i + 1 < n) { /* a cell not read yet, found from its bucket: a paused or retried sweep's */
+            size_t j = i + 1 + (size_t)(next_u64() % (n - i - 1));
+            vpdsi_cells_get(c, j, d, got);
+            same &= memcmp(got, copy + j * d, (size_t)d * sizeof *got) == 0;
+            vpdsi_cells_get(c, i + 1, d, got);
+            same &= memcmp(got, copy + (i + 1) * d, (size_t)d * sizeof *got) == 0;
+        }
     }
     CHECK_MSG(same, "dim %d: a cell read back from a reversed array differs (families %d)", d, c->families);
     CHECK_MSG(reversed_room(c) <= start / 8 + 8 && (n < 64 || gave >= 8),
