@@ -161,6 +161,13 @@ static const uint8_t *record(const vpdsi_cells *c, size_t f) { return c->fam + p
 static void swap_bytes(uint8_t *a, uint8_t *b, size_t n)
 {
     size_t k;
+    if (n == 4) { /* a 32-bit cell, the common case: one load and store each way */
+        uint32_t t;
+        memcpy(&t, a, 4);
+        memcpy(a, b, 4);
+        memcpy(b, &t, 4);
+        return;
+    }
     for (k = 0; k < n; k++) {
         uint8_t t = a[k];
         a[k] = b[k];
@@ -170,23 +177,12 @@ static void swap_bytes(uint8_t *a, uint8_t *b, size_t n)
 
 void vpdsi_cells_reverse(vpdsi_cells *c)
 {
+    /* the records swapped whole: a family's, a 32-bit cell's, or a cell's 64-bit words */
+    uint8_t *base = c->families ? c->fam : (uint8_t *)c->words;
     size_t a, b, n = c->families ? c->n_fam : c->count;
+    size_t size = c->families ? c->fam_bytes : c->words_per_cell ? 8u * c->words_per_cell : 4u;
     if (c->reversed || n == 0) return;
-    for (a = 0, b = n - 1; a < b; a++, b--) {
-        if (c->families) {
-            swap_bytes(c->fam + a * c->fam_bytes, c->fam + b * c->fam_bytes, c->fam_bytes);
-        } else if (c->words_per_cell == 0) {
-            uint32_t t = half_get(c, a);
-            half_set(c, a, half_get(c, b));
-            half_set(c, b, t);
-        } else {
-            uint64_t t[VPDSI_CELLS_MAX_WORDS];
-            size_t bytes = c->words_per_cell * sizeof *t;
-            memcpy(t, c->words + a * c->words_per_cell, bytes);
-            memcpy(c->words + a * c->words_per_cell, c->words + b * c->words_per_cell, bytes);
-            memcpy(c->words + b * c->words_per_cell, t, bytes);
-        }
-    }
+    for (a = 0, b = n - 1; a < b; a++, b--) swap_bytes(base + a * size, base + b * size, size);
     c->reversed = 1;
     c->rev_top = n - 1;
 }

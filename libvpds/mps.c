@@ -1011,7 +1011,8 @@ static vpds_status sweep_chunk(vpdsi_mps *m, const vpdsi_ctx *ctx, size_t n, int
         /* the coverage searches' boxes are work too: a budget bounds them */
         if (j + 1 + (m->unc.boxes - boxes0) >= n) break;
     }
-    if (!run->implicit) vpdsi_cells_give_back_read(&run->cur, ctx->mem, (size_t)run->pos);
+    /* a level finish_sweep stored back to front (level 0's implicit cells are not) */
+    vpdsi_cells_give_back_read(&run->cur, ctx->mem, (size_t)run->pos);
     return VPDS_OK;
 }
 
