@@ -173,7 +173,7 @@ int vpdsi_bgrid_setup(vpdsi_bgrid *g, vpdsi_mem *m, int dim, const uint64_t *n, 
 oom:
     vpdsi_mem_free(m, tmp, cap_tmp * sizeof *tmp);
     vpdsi_bgrid_release(g, m);
-    return -1;
+    return -2;
 }
 
 uint64_t vpdsi_bgrid_locate(const vpdsi_bgrid *g, const double *x)

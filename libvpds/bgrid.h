@@ -46,7 +46,9 @@ static inline int vpdsi_bgrid_serves(int dim, int constant_radius, int two_radii
 /* Cells (border included) of a grid of n[k] cells of side side[k] per axis for reach; 0 past
  * the stencil width setup accepts. */
 double vpdsi_bgrid_cells(int dim, const double *n, const double *side, double reach);
-/* Lay out over the base grid and empty it; reach is the conflict distance (>= the diagonal). */
+/* Lay out over the base grid and empty it; reach is the conflict distance (>= the diagonal).
+ * 0: done; -1: the grid does not serve this radius (its stencil too wide, its cells too many);
+ * -2: out of memory (nothing is left allocated). */
 int vpdsi_bgrid_setup(vpdsi_bgrid *g, vpdsi_mem *m, int dim, const uint64_t *n, const double *lo,
                       const double *side, double reach);
 void vpdsi_bgrid_release(vpdsi_bgrid *g, vpdsi_mem *m);

@@ -95,8 +95,10 @@ static int grid_index_all(vpdsi_store *st, const vpdsi_problem *pb)
     return 0;
 }
 
-/* The background grid serves a uniform radius where vpdsi_bgrid_serves says; the kd-tree
- * everything else.
+/* The background grid serves a uniform radius where vpdsi_bgrid_serves and its setup say; the
+ * kd-tree everything else. Which one serves depends on the problem alone: the two give valid
+ * samplings that can differ at the precision limit, so a failed allocation is an error to retry,
+ * never a switch of index (a retried run gives the points of one that never failed).
  * (vpdsi_bgrid_setup releases the grid of an earlier scale; the kd-tree path releases it below.) */
 static vpds_status choose_index(vpdsi_mps *m, const vpdsi_ctx *ctx, int keep_tree)
 {
@@ -104,17 +106,26 @@ static vpds_status choose_index(vpdsi_mps *m, const vpdsi_ctx *ctx, int keep_tre
     vpdsi_store *st = ctx->st;
     vpdsi_run *run = &m->run;
     double reach = run->t * pb->inhibition * st->sizing.radius;
+    int fit = -1;
     st->grid_mode = 0;
     if (vpdsi_bgrid_serves(pb->dim, st->sizing.kind == VPDSI_SIZING_CONSTANT, pb->two_radii,
-                           pb->any_periodic) && !keep_tree &&
-        vpdsi_bgrid_setup(&st->grid, ctx->mem, pb->dim, run->geom.n0, pb->lo, run->geom.side0, reach) == 0 &&
-        vpdsi_mem_reserve(ctx->mem, (void **)&m->cand, &m->cap_cand, st->grid.n_stencil + 1,
-                          sizeof(int32_t)) == 0 &&
-        vpdsi_mem_reserve(ctx->mem, (void **)&m->cand_x, &m->cap_cand_x,
-                          (st->grid.n_stencil + 1) * (size_t)pb->dim, sizeof(double)) == 0 &&
-        vpdsi_mem_reserve(ctx->mem, (void **)&m->cand_tag, &m->cap_cand_tag, st->grid.n_stencil + 1,
-                          sizeof(uint16_t)) == 0 &&
-        grid_index_all(st, pb) == 0) {
+                           pb->any_periodic) && !keep_tree)
+        fit = vpdsi_bgrid_setup(&st->grid, ctx->mem, pb->dim, run->geom.n0, pb->lo, run->geom.side0, reach);
+    if (fit == 0 &&
+        (vpdsi_mem_reserve(ctx->mem, (void **)&m->cand, &m->cap_cand, st->grid.n_stencil + 1,
+                           sizeof(int32_t)) ||
+         vpdsi_mem_reserve(ctx->mem, (void **)&m->cand_x, &m->cap_cand_x,
+                           (st->grid.n_stencil + 1) * (size_t)pb->dim, sizeof(double)) ||
+         vpdsi_mem_reserve(ctx->mem, (void **)&m->cand_tag, &m->cap_cand_tag, st->grid.n_stencil + 1,
+                           sizeof(uint16_t))))
+        fit = -2;
+    if (fit == -2) {
+        vpdsi_bgrid_release(&st->grid, ctx->mem);
+        vpdsi_store_error(st, "out of memory setting up the background grid over %llu base cells"
+                          " (t = %g)", (unsigned long long)run->base_count, run->t);
+        return VPDS_ERR_OUT_OF_MEMORY;
+    }
+    if (fit == 0 && grid_index_all(st, pb) == 0) {
         st->grid_mode = 1;
         return VPDS_OK;
     }
