@@ -281,9 +281,37 @@ static vpds_status seed_step(vpdsi_surface *s, const vpdsi_surface_ctx *ctx, uin
     return VPDS_OK;
 }
 
+/* The first index whose running sum exceeds u (the last when none does): a binary search's
+ * answer, found from where u would fall were the areas equal (they nearly are, level by level),
+ * by galloping to a bracket and bisecting it: a few reads where bisection took log2 n. */
 static size_t search_running_sums(const double *cum, size_t n, double u)
 {
-    size_t lo = 0, hi = n - 1;
+    double at = u / cum[n - 1] * (double)n;
+    size_t guess = at >= 0 && at < (double)n ? (size_t)at : n - 1, lo, hi, step = 1;
+    if (cum[guess] > u || guess == n - 1) {
+        hi = guess; /* the answer is at most guess: down to a sum at most u */
+        for (;;) {
+            size_t t = hi > step ? hi - step : 0;
+            if (hi == 0) return 0;
+            if (cum[t] <= u) {
+                lo = t + 1;
+                break;
+            }
+            hi = t;
+            step <<= 1;
+        }
+    } else {
+        lo = guess + 1; /* the answer lies past guess: up to a sum above u, or the end */
+        for (;;) {
+            size_t t = n - 1 - lo > step ? lo + step : n - 1;
+            if (cum[t] > u || t == n - 1) {
+                hi = t;
+                break;
+            }
+            lo = t + 1;
+            step <<= 1;
+        }
+    }
     while (lo < hi) {
         size_t mid = lo + (hi - lo) / 2;
         if (cum[mid] > u) hi = mid; else lo = mid + 1;
