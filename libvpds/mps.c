@@ -134,7 +134,7 @@ static vpds_status choose_index(vpdsi_mps *m, const vpdsi_ctx *ctx, int keep_tre
      * and the domain's reads the kd-tree, which then lags behind until synced) */
     if (st->sizing.kind != VPDSI_SIZING_CONSTANT && pb->dim <= 3 && !pb->two_radii &&
         !pb->any_periodic && !keep_tree && !ctx->dom->fn)
-        return vpdsi_store_use_ogrid(st, run->t * pb->inhibition * st->sizing.rmax);
+        return vpdsi_store_use_ogrid(st, run->t * pb->inhibition * st->sizing.rmax, 0, 0);
     return vpdsi_store_sync_tree(st);
 }
 

@@ -8,7 +8,26 @@
 
 static const double open_axes[3] = {0, 0, 0};
 
-int vpdsi_ogrid_setup(vpdsi_ogrid *g, int dim, const double *lo, const double *hi, double top)
+/* The coarsest levels whose cells over the box number at most budget in all: arrays, not the
+ * table (their cells along an axis: the box's extent over the side, rounded down, plus one). */
+static void plan_dense(vpdsi_ogrid *g, const double *lo, const double *hi, double budget)
+{
+    double used = 0;
+    int k, l;
+    for (l = 0; l < g->levels; l++) {
+        double cells = 1;
+        for (k = 0; k < g->dim; k++) cells *= floor((hi[k] - lo[k]) * g->lv[l].inv) + 1;
+        if (!(used + cells <= budget)) break;
+        used += cells;
+        g->lv[l].cells = (size_t)cells;
+        for (k = 0; k < 3; k++)
+            g->lv[l].dn[k] = k < g->dim ? (uint64_t)floor((hi[k] - lo[k]) * g->lv[l].inv) + 1 : 1;
+    }
+    g->hashed = g->levels - l;
+}
+
+int vpdsi_ogrid_setup(vpdsi_ogrid *g, int dim, const double *lo, const double *hi, double top,
+                      double bottom, double dense_cells)
 {
     double ext = 0;
     int k, l;
@@ -23,15 +42,44 @@ int vpdsi_ogrid_setup(vpdsi_ogrid *g, int dim, const double *lo, const double *h
     /* a box wider than 2^BITS cells of the largest radius: coordinates would be clamped and
      * samples filed where queries do not look */
     if (!(ext / top < (double)CELL_MAX)) return -2;
-    /* levels while a cell coordinate fits its bits; smaller radii share the last level. The
-     * first is 2 top wide: a sample goes where the side is at least 2r (level_of) */
+    /* levels while a cell coordinate fits its bits, and none past the level of the least
+     * radius; smaller radii share the last level. The first is 2 top wide: a sample goes
+     * where the side is at least 2r (level_of) */
     for (l = 0; l < VPDSI_OGRID_LEVELS; l++) {
         double side = ldexp(2 * top, -l);
-        if (l > 0 && !(ext / side < (double)CELL_MAX)) break;
+        if (l > 0 && (!(ext / side < (double)CELL_MAX) || !(side >= 2 * bottom))) break;
         g->lv[l].side = side;
         g->lv[l].inv = 1 / side;
     }
     g->levels = l;
+    plan_dense(g, lo, hi, dense_cells);
+    return 0;
+}
+
+static void free_dense(vpdsi_ogrid *g, vpdsi_mem *m)
+{
+    int l;
+    for (l = 0; l < g->levels; l++) {
+        vpdsi_mem_free(m, g->lv[l].dense, g->lv[l].dense ? g->lv[l].cells * sizeof *g->lv[l].dense : 0);
+        g->lv[l].dense = NULL;
+    }
+}
+
+/* The dense levels' arrays, empty, at the first reserve: all of them, or none (-1). */
+static int alloc_dense(vpdsi_ogrid *g, vpdsi_mem *m)
+{
+    int l;
+    size_t j;
+    for (l = 0; l < g->levels - g->hashed; l++) {
+        vpdsi_ogrid_level *lv = &g->lv[l];
+        if (lv->dense) continue;
+        lv->dense = (int32_t *)vpdsi_mem_alloc(m, lv->cells * sizeof *lv->dense);
+        if (!lv->dense) {
+            free_dense(g, m);
+            return -1;
+        }
+        for (j = 0; j < lv->cells; j++) lv->dense[j] = -1;
+    }
     return 0;
 }
 
@@ -40,6 +88,7 @@ void vpdsi_ogrid_release(vpdsi_ogrid *g, vpdsi_mem *m)
     vpdsi_mem_free(m, g->keys, g->cap * sizeof *g->keys);
     vpdsi_mem_free(m, g->heads, g->cap * sizeof *g->heads);
     vpdsi_mem_free(m, g->next, g->cap_next * sizeof *g->next);
+    free_dense(g, m);
     g->keys = NULL;
     g->heads = g->next = NULL;
     g->cap = g->used = g->cap_next = 0;
@@ -57,7 +106,10 @@ int vpdsi_ogrid_reserve(vpdsi_ogrid *g, vpdsi_mem *m, size_t n_total, size_t mor
     size_t cap = g->cap ? g->cap : 64, i;
     uint64_t *keys;
     int32_t *heads;
-    if (vpdsi_mem_reserve_fine(m, (void **)&g->next, &g->cap_next, n_total, sizeof *g->next)) return -1;
+    if (vpdsi_mem_reserve_fine(m, (void **)&g->next, &g->cap_next, n_total, sizeof *g->next) ||
+        alloc_dense(g, m))
+        return -1;
+    if (g->hashed == 0) return 0; /* every level in arrays: no table */
     while (cap / 2 < g->used + more) {
         if (cap > ((size_t)-1) / 4 / sizeof *keys) return -1;
         cap *= 2;
@@ -105,6 +157,15 @@ static uint64_t key_of(int l, const uint64_t *c, int dim)
     return key + 1;
 }
 
+/* Where a dense level keeps cell c (dim coordinates). */
+static size_t dense_at(const vpdsi_ogrid_level *lv, int dim, const uint64_t *c)
+{
+    size_t j = 0;
+    int k;
+    for (k = dim - 1; k >= 0; k--) j = j * (size_t)lv->dn[k] + (size_t)c[k];
+    return j;
+}
+
 static int level_of(const vpdsi_ogrid *g, double r)
 {
     int l = 0;
@@ -120,7 +181,7 @@ void vpdsi_ogrid_insert(vpdsi_ogrid *g, const vpdsi_kd_samples *s, int32_t i)
     uint64_t c[3] = {0, 0, 0};
     size_t j;
     for (k = 0; k < g->dim; k++) {
-        c[k] = cell_at(g, l, k, x[k], 0, CELL_MAX);
+        c[k] = cell_at(g, l, k, x[k], 0, lv->dense ? lv->dn[k] - 1 : CELL_MAX);
         if (lv->count == 0 || x[k] < lv->lo[k]) lv->lo[k] = x[k];
         if (lv->count == 0 || x[k] > lv->hi[k]) lv->hi[k] = x[k];
         if (lv->count == 0 || c[k] < lv->clo[k]) lv->clo[k] = c[k];
@@ -128,6 +189,12 @@ void vpdsi_ogrid_insert(vpdsi_ogrid *g, const vpdsi_kd_samples *s, int32_t i)
     }
     if (lv->count == 0 || s->r[i] > lv->rmax) lv->rmax = s->r[i];
     lv->count++;
+    if (lv->dense) {
+        j = dense_at(lv, g->dim, c);
+        g->next[i] = lv->dense[j];
+        lv->dense[j] = i;
+        return;
+    }
     j = slot_of(g, key_of(l, c, g->dim));
     if (g->keys[j] == 0) {
         g->keys[j] = key_of(l, c, g->dim);
@@ -227,6 +294,7 @@ static int slot_in_range(const vpdsi_ogrid *g, size_t j, int l, const uint64_t *
 static int32_t head_of(const vpdsi_ogrid *g, int l, const uint64_t *c)
 {
     size_t j;
+    if (g->lv[l].dense) return g->lv[l].dense[dense_at(&g->lv[l], g->dim, c)];
     if (g->cap == 0) return -1;
     j = slot_of(g, key_of(l, c, g->dim));
     return g->keys[j] ? g->heads[j] : -1;
@@ -265,8 +333,19 @@ void vpdsi_ogrid_prefetch(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const
     const vpdsi_ogrid_level *lv = &g->lv[l];
     uint64_t c[3], key;
     size_t j;
-    if (g->cap == 0 || lv->count == 0) return;
-    for (k = 0; k < g->dim; k++) c[k] = cell_at(g, l, k, y[k], 0, CELL_MAX);
+    if (lv->count == 0 || (!lv->dense && g->cap == 0)) return;
+    for (k = 0; k < g->dim; k++) c[k] = cell_at(g, l, k, y[k], 0, lv->dense ? lv->dn[k] - 1 : CELL_MAX);
+    if (lv->dense) {
+        int32_t i = lv->dense[dense_at(lv, g->dim, c)];
+        if (stage == 0) {
+            VPDSI_PREFETCH(lv->dense + dense_at(lv, g->dim, c));
+        } else if (i >= 0) {
+            VPDSI_PREFETCH(s->x + (size_t)i * (size_t)g->dim);
+            VPDSI_PREFETCH(s->r + i);
+            VPDSI_PREFETCH(g->next + i);
+        }
+        return;
+    }
     key = key_of(l, c, g->dim);
     if (stage == 0) {
         j = (size_t)vpdsi_mix64(key) & (g->cap - 1);
@@ -321,7 +400,7 @@ int32_t vpdsi_ogrid_conflict(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, co
         if (!cell_beyond(g, l, yc, y, y, reach) &&
             (hit = chain_conflict(g, s, head_of(g, l, yc), y, ry, rule, scale, lipschitz, witness)) != -1)
             return hit;
-        scan = range_cells(g->dim, a, b) > (double)g->cap;
+        scan = !g->lv[l].dense && range_cells(g->dim, a, b) > (double)g->cap;
         while (next_range_cell(g, l, a, b, scan, c, &pos, &i)) {
             if (i < 0 || !memcmp(c, yc, (size_t)g->dim * sizeof *c) || cell_beyond(g, l, c, y, y, reach))
                 continue;
@@ -348,7 +427,7 @@ int vpdsi_ogrid_gather(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const do
         reach = scale * vpdsi_rule_f((vpds_rule)rule, g->lv[l].rmax, r_hi);
         /* a sample covers a sub-box only from within its reach of the box */
         if (!cell_range(g, l, lo, hi, reach, a, b)) continue;
-        scan = range_cells(g->dim, a, b) > (double)g->cap;
+        scan = !g->lv[l].dense && range_cells(g->dim, a, b) > (double)g->cap;
         while (next_range_cell(g, l, a, b, scan, c, &pos, &i)) {
             if (i < 0 || cell_beyond(g, l, c, lo, hi, reach)) continue;
             for (; i >= 0; i = g->next[i]) {
@@ -386,7 +465,7 @@ int vpdsi_ogrid_near_box(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const 
         /* the widest of the level's samples' tests, as vpdsi_prox_near widens it */
         reach = scale * (g->lv[l].rmax > r_bound ? g->lv[l].rmax : r_bound) * (1 + 1e-9);
         if (!cell_range(g, l, lo, hi, reach, a, b)) continue;
-        scan = range_cells(g->dim, a, b) > (double)g->cap;
+        scan = !g->lv[l].dense && range_cells(g->dim, a, b) > (double)g->cap;
         while (next_range_cell(g, l, a, b, scan, c, &pos, &i)) {
             if (i < 0 || cell_beyond(g, l, c, lo, hi, reach)) continue;
             for (; i >= 0; i = g->next[i]) {

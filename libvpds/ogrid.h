@@ -18,10 +18,18 @@ typedef struct vpdsi_ogrid_level {
     double lo[3], hi[3];           /* bounding box of its samples */
     uint64_t clo[3], chi[3];       /* ... in cells */
     size_t count;
+    /* a level with few cells over the whole box holds its cells' first samples in an array, by
+     * cell, rather than in the table (no hashing): dn[k] cells per axis, cells in all (0: the
+     * table); a sample past the box's far side goes to its last cell, as the table's clamp does
+     * at its last coordinate */
+    int32_t *dense;
+    uint64_t dn[3];
+    size_t cells;
 } vpdsi_ogrid_level;
 
 typedef struct vpdsi_ogrid {
     int dim, levels;               /* levels in use: side >= the box extent / 2^BITS */
+    int hashed;                    /* levels past the dense ones (they file in the table) */
     double lo[3];
     vpdsi_ogrid_level lv[VPDSI_OGRID_LEVELS];
     uint64_t *keys;                /* 0: empty slot; else 1 + (level, cell) */
@@ -31,9 +39,12 @@ typedef struct vpdsi_ogrid {
     size_t cap_next;
 } vpdsi_ogrid;
 
-/* Lay out over the box [lo, hi] for radii up to about top; -1 when dim > 3, -2 when the box is
- * 2^BITS cells of side top wide or more (nothing held either way). */
-int vpdsi_ogrid_setup(vpdsi_ogrid *g, int dim, const double *lo, const double *hi, double top);
+/* Lay out over the box [lo, hi] for radii from bottom (0: unknown) up to about top; the
+ * coarsest levels whose cells over the box number at most dense_cells in all are held in arrays
+ * (vpdsi_ogrid_reserve allocates them). -1 when dim > 3, -2 when the box is 2^BITS cells of side
+ * top wide or more (nothing held either way). */
+int vpdsi_ogrid_setup(vpdsi_ogrid *g, int dim, const double *lo, const double *hi, double top,
+                      double bottom, double dense_cells);
 void vpdsi_ogrid_release(vpdsi_ogrid *g, vpdsi_mem *m);
 /* Room for `more` inserts, the grid then holding n_total samples; -1 on OOM (nothing lost). */
 int vpdsi_ogrid_reserve(vpdsi_ogrid *g, vpdsi_mem *m, size_t n_total, size_t more);

@@ -157,13 +157,13 @@ void vpdsi_store_drop_index(vpdsi_store *st)
     st->grid_mode = st->ogrid_mode = 0;
 }
 
-vpds_status vpdsi_store_use_ogrid(vpdsi_store *st, double top)
+vpds_status vpdsi_store_use_ogrid(vpdsi_store *st, double top, double bottom, double dense_cells)
 {
     vpdsi_kd_samples v = vpdsi_store_view(st);
     size_t i;
     int fit;
     vpdsi_store_drop_index(st);
-    if ((fit = vpdsi_ogrid_setup(&st->ogrid, st->dim, st->lo, st->hi, top)) == -2)
+    if ((fit = vpdsi_ogrid_setup(&st->ogrid, st->dim, st->lo, st->hi, top, bottom, dense_cells)) == -2)
         return vpdsi_store_sync_tree(st); /* too wide for the grid's cells: the kd-tree serves */
     if (fit) {
         vpdsi_store_error(st, "the octave grid holds dim <= 3, not %d", st->dim);

@@ -61,11 +61,12 @@ void vpdsi_store_append(vpdsi_store *st, const double *x, double r, double t, ui
  * stream's triangulation), so that samples are not indexed twice. */
 vpds_status vpdsi_store_reserve_lagging(vpdsi_store *st, size_t more);
 void vpdsi_store_append_lagging(vpdsi_store *st, const double *x, double r, double t, uint8_t flags);
-/* Index the samples (dim <= 3) with the octave grid (radii up to about top) until use_tree or
+/* Index the samples (dim <= 3) with the octave grid (radii from bottom, 0 if unknown, up to
+ * about top; its coarsest levels in arrays of up to dense_cells cells) until use_tree or
  * drop_index; queries then go through vpdsi_store_conflict and vpdsi_store_gather. A box too
  * wide for the grid's cells keeps the kd-tree (synced). On failure the store is left with no
  * accelerator (the kd-tree, maybe lagging). */
-vpds_status vpdsi_store_use_ogrid(vpdsi_store *st, double top);
+vpds_status vpdsi_store_use_ogrid(vpdsi_store *st, double top, double bottom, double dense_cells);
 /* Done at a scale: drop the background or octave grid (the kd-tree lags behind, synced when
  * next needed). */
 void vpdsi_store_drop_index(vpdsi_store *st);

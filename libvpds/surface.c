@@ -192,20 +192,34 @@ static vpds_status seed_radius(const vpdsi_surface_ctx *ctx, uint32_t k, double 
     return vpdsi_trimesh_radius(ctx->mesh, ctx->st, k, uv, c, r);
 }
 
-/* Index the samples: the octave grid when the largest radius is known, else the kd-tree. */
+/* A maximal set's samples per r^2 of area (2D; 0.698 on the unit square at r = 0.002). */
+#define SAMPLES_PER_DISK_AREA 0.7
+/* Cells per expected sample that the octave grid may hold in arrays (4 bytes each). */
+#define DENSE_CELLS_PER_SAMPLE 4
+
+/* Index the samples: the octave grid when the largest radius is known, else the kd-tree. Its
+ * levels stop at the least radius (vertex radii interpolate between their vertices'); the
+ * coarsest go in arrays while their cells over the mesh's box are few beside the samples
+ * expected (a flat or gently curved mesh; a sphere's box has 30 times too many). */
 static vpds_status choose_sample_index(const vpdsi_surface *s, const vpdsi_surface_ctx *ctx)
 {
+    const vpdsi_trimesh *mesh = ctx->mesh;
     vpdsi_store *st = ctx->st;
-    double top = 0;
+    double top = 0, bottom = INFINITY, scale = s->t * ctx->coverage, expect;
     size_t k;
     vpds_status e = vpdsi_store_use_tree(st);
     if (e != VPDS_OK) return e;
-    if (ctx->mesh->vr) {
-        for (k = 0; k < ctx->mesh->n_vertices; k++) top = ctx->mesh->vr[k] > top ? ctx->mesh->vr[k] : top;
+    if (mesh->vr) {
+        for (k = 0; k < mesh->n_vertices; k++) {
+            top = mesh->vr[k] > top ? mesh->vr[k] : top;
+            bottom = mesh->vr[k] < bottom ? mesh->vr[k] : bottom;
+        }
     } else if (st->sizing.kind == VPDSI_SIZING_CONSTANT) {
-        top = st->sizing.radius;
+        top = bottom = st->sizing.radius;
     }
-    return top > 0 ? vpdsi_store_use_ogrid(st, s->t * ctx->coverage * top) : VPDS_OK;
+    if (!(top > 0)) return VPDS_OK;
+    expect = SAMPLES_PER_DISK_AREA * s->tri_cum[mesh->n_live - 1] / (scale * top * scale * top);
+    return vpdsi_store_use_ogrid(st, scale * top, bottom, DENSE_CELLS_PER_SAMPLE * expect);
 }
 
 static void begin_piece_darts(vpdsi_surface *s, double per_piece, double pieces)

@@ -63,8 +63,9 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
     int q, k, rule;
     double rmax = 0;
     char *mark = (char *)calloc((size_t)n, 1);
-    vpdsi_ogrid og;
+    vpdsi_ogrid og, ogd; /* hashed cells; levels from the least radius, the coarsest in arrays */
     int use_og = dim <= 3;
+    double rmin = INFINITY;
     int32_t *out2 = NULL;
     size_t cnt2 = 0, cap2 = 0;
     double box_lo[6] = {0}, box_hi[6] = {1, 1, 1, 1, 1, 1};
@@ -76,12 +77,18 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
     for (i = 0; i < n; i++) {
         vpdsi_kd_insert(&t, &s, i);
         if (r[i] > rmax) rmax = r[i];
+        if (r[i] < rmin) rmin = r[i];
     }
     /* the octave grid over the same samples (their box: [0, 1]^dim) */
     if (use_og) {
-        CHECK(vpdsi_ogrid_setup(&og, dim, box_lo, box_hi, rmax) == 0);
+        CHECK(vpdsi_ogrid_setup(&og, dim, box_lo, box_hi, rmax, 0, 0) == 0);
         CHECK(vpdsi_ogrid_reserve(&og, &m, (size_t)n, (size_t)n) == 0);
         for (i = 0; i < n; i++) vpdsi_ogrid_insert(&og, &s, i);
+        CHECK(vpdsi_ogrid_setup(&ogd, dim, box_lo, box_hi, rmax, rmin, 200000) == 0);
+        CHECK(vpdsi_ogrid_reserve(&ogd, &m, (size_t)n, (size_t)n) == 0);
+        for (i = 0; i < n; i++) vpdsi_ogrid_insert(&ogd, &s, i);
+        CHECK_MSG(ogd.levels > ogd.hashed && ogd.levels <= og.levels, "%s: %d levels, %d of them in "
+                  "arrays, against %d", name, ogd.levels, ogd.levels - ogd.hashed, og.levels);
     }
     f.params = DEFAULT_FLANN_PARAMETERS;
     f.params.algorithm = FLANN_INDEX_KDTREE_SINGLE;
@@ -119,6 +126,7 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
             int32_t w, ours = vpdsi_kd_conflict(&t, &s, p, rp, rule, 1.0, -1.0, &w) >= 0, ref = 0,
                        ambiguous = 0;
             int32_t grid = use_og ? vpdsi_ogrid_conflict(&og, &s, p, rp, rule, 1.0, -1.0, &w) >= 0 : ours;
+            int32_t dense = use_og ? vpdsi_ogrid_conflict(&ogd, &s, p, rp, rule, 1.0, -1.0, &w) >= 0 : ours;
             for (j = 0; j < nf; j++) {
                 int id = f.idx[j];
                 double fr = vpdsi_rule_f((vpds_rule)rule, r[id], rp), d2 = dist2(p, x + id * dim, dim);
@@ -130,6 +138,8 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
             if (grid != ref && !ambiguous)
                 CHECK_MSG(0, "%s: octave grid conflict rule %d: ours %d, FLANN %d", name, rule, grid, ref);
             CHECK_MSG(grid == ours, "%s: octave grid and kd-tree conflicts differ (rule %d)", name, rule);
+            CHECK_MSG(dense == ours, "%s: the octave grid with arrays and the kd-tree's conflicts "
+                      "differ (rule %d)", name, rule);
         }
         /* each rule's box coverage primitive on a box around p */
         {
@@ -142,6 +152,24 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
             }
             half = sqrt(half);
             nf = flann_within(&f, n, c, (rmax > rp ? rmax : rp) + half);
+            if (use_og) {
+                /* the samples near the box: the kd-tree's, the grid's and the grid's with arrays */
+                size_t a;
+                cnt = cnt2 = 0;
+                CHECK(vpdsi_kd_near_box(&t, &s, lo, hi, rp, 1.0, 0, (size_t)n + 1, &m, &out, &cnt, &cap) == 0);
+                memset(mark, 0, (size_t)n);
+                for (a = 0; a < cnt; a++) mark[out[a]] |= 1;
+                CHECK(vpdsi_ogrid_near_box(&og, &s, lo, hi, rp, 1.0, &m, &out2, &cnt2, &cap2) == 0);
+                for (a = 0; a < cnt2; a++) mark[out2[a]] |= 2;
+                cnt2 = 0;
+                CHECK(vpdsi_ogrid_near_box(&ogd, &s, lo, hi, rp, 1.0, &m, &out2, &cnt2, &cap2) == 0);
+                for (a = 0; a < cnt2; a++) mark[out2[a]] |= 4;
+                for (a = 0; a < (size_t)n; a++)
+                    if (mark[a] != 0 && mark[a] != 7) break;
+                CHECK_MSG(a == (size_t)n && cnt == cnt2, "%s: the samples near a box differ (kd-tree "
+                          "%zu, octave grid with arrays %zu; sample %zu: %d)", name, cnt, cnt2, a,
+                          a < (size_t)n ? mark[a] : 0);
+            }
             for (rule = VPDS_RULE_PRIOR; rule <= VPDS_RULE_SMALLER; rule++) {
                 int ours, ref = 0, ambiguous = 0;
                 cnt = 0;
@@ -171,6 +199,14 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
                                 break;
                         CHECK_MSG(a == (size_t)n, "%s: vpdsi_ogrid_gathers (rule %d, split %d) and "
                                   "the gather disagree on sample %zu", name, rule, split, a);
+                        cnt2 = 0;
+                        CHECK(vpdsi_ogrid_gather(&ogd, &s, lo, hi, rp, rule, 1.0, split, &m, &out2, &cnt2, &cap2) == 0);
+                        for (a = 0; a < cnt2; a++) mark[out2[a]] |= 4;
+                        for (a = 0; a < (size_t)n; a++)
+                            if (((mark[a] & 2) != 0) != ((mark[a] & 4) != 0)) break;
+                        CHECK_MSG(a == (size_t)n && cnt == cnt2, "%s: the octave grid with arrays "
+                                  "gathers other samples (rule %d, split %d): %zu against %zu", name,
+                                  rule, split, cnt2, cnt);
                     }
                     cnt = 0;
                     CHECK(vpdsi_kd_gather(&t, &s, lo, hi, rp, rule, 1.0, 0, &m, &out, &cnt, &cap) == 0);
@@ -192,7 +228,10 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
     free(f.dist);
     vpdsi_mem_free(&m, out, cap * sizeof *out);
     vpdsi_mem_free(&m, out2, cap2 * sizeof *out2);
-    if (use_og) vpdsi_ogrid_release(&og, &m);
+    if (use_og) {
+        vpdsi_ogrid_release(&og, &m);
+        vpdsi_ogrid_release(&ogd, &m);
+    }
     free(mark);
     vpdsi_kd_release(&t, &m);
     CHECK(m.held == 0);
