@@ -15,15 +15,19 @@ static void plan_dense(vpdsi_ogrid *g, const double *lo, const double *hi, doubl
     double used = 0;
     int k, l;
     for (l = 0; l < g->levels; l++) {
-        double cells = 1;
-        for (k = 0; k < g->dim; k++) cells *= floor((hi[k] - lo[k]) * g->lv[l].inv) + 1;
-        if (!(used + cells <= budget)) break;
-        used += cells;
-        g->lv[l].cells = (size_t)cells;
-        for (k = 0; k < 3; k++)
-            g->lv[l].dn[k] = k < g->dim ? (uint64_t)floor((hi[k] - lo[k]) * g->lv[l].inv) + 1 : 1;
+        vpdsi_ogrid_level *lv = &g->lv[l];
+        size_t cells = 1, bytes;
+        for (k = 0; k < 3; k++) {
+            double n = k < g->dim ? floor((hi[k] - lo[k]) * lv->inv) + 1 : 1;
+            if (!(n <= (double)CELL_MAX + 1) || vpdsi_mul_size(cells, (size_t)n, &cells)) break;
+            lv->dn[k] = (uint64_t)n;
+        }
+        if (k < 3 || vpdsi_mul_size(cells, sizeof *lv->dense, &bytes) || !(used + (double)cells <= budget))
+            break;
+        used += (double)cells;
+        lv->cells = cells;
     }
-    g->hashed = g->levels - l;
+    g->n_hashed = g->levels - l;
 }
 
 int vpdsi_ogrid_setup(vpdsi_ogrid *g, int dim, const double *lo, const double *hi, double top,
@@ -60,7 +64,7 @@ static void free_dense(vpdsi_ogrid *g, vpdsi_mem *m)
 {
     int l;
     for (l = 0; l < g->levels; l++) {
-        vpdsi_mem_free(m, g->lv[l].dense, g->lv[l].dense ? g->lv[l].cells * sizeof *g->lv[l].dense : 0);
+        vpdsi_mem_free(m, g->lv[l].dense, g->lv[l].cells * sizeof *g->lv[l].dense);
         g->lv[l].dense = NULL;
     }
 }
@@ -70,7 +74,7 @@ static int alloc_dense(vpdsi_ogrid *g, vpdsi_mem *m)
 {
     int l;
     size_t j;
-    for (l = 0; l < g->levels - g->hashed; l++) {
+    for (l = 0; l < g->levels - g->n_hashed; l++) {
         vpdsi_ogrid_level *lv = &g->lv[l];
         if (lv->dense) continue;
         lv->dense = (int32_t *)vpdsi_mem_alloc(m, lv->cells * sizeof *lv->dense);
@@ -109,7 +113,7 @@ int vpdsi_ogrid_reserve(vpdsi_ogrid *g, vpdsi_mem *m, size_t n_total, size_t mor
     if (vpdsi_mem_reserve_fine(m, (void **)&g->next, &g->cap_next, n_total, sizeof *g->next) ||
         alloc_dense(g, m))
         return -1;
-    if (g->hashed == 0) return 0; /* every level in arrays: no table */
+    if (g->n_hashed == 0) return 0; /* every level in arrays: no table */
     while (cap / 2 < g->used + more) {
         if (cap > ((size_t)-1) / 4 / sizeof *keys) return -1;
         cap *= 2;
@@ -252,14 +256,18 @@ static int next_cell(int dim, const uint64_t *a, const uint64_t *b, uint64_t *c)
 }
 
 /* Whether cell c of level l lies farther than reach (widened as in cell_range) from the box
- * [lo, hi]: its samples need no test. */
+ * [lo, hi]: its samples need no test. A first or last cell (the clamp's) holds samples beyond
+ * the box too: on that side it reaches to the level's samples. */
 static int cell_beyond(const vpdsi_ogrid *g, int l, const uint64_t *c, const double *lo,
                        const double *hi, double reach)
 {
-    double side = g->lv[l].side, wide = reach * (1 + 1e-9), s = 0;
+    const vpdsi_ogrid_level *lv = &g->lv[l];
+    double side = lv->side, wide = reach * (1 + 1e-9), s = 0;
     int k;
     for (k = 0; k < g->dim; k++) {
         double clo = g->lo[k] + (double)c[k] * side, chi = clo + side, e;
+        if (c[k] == 0 && lv->lo[k] < clo) clo = lv->lo[k];
+        if (c[k] == (lv->dense ? lv->dn[k] - 1 : CELL_MAX) && lv->hi[k] > chi) chi = lv->hi[k];
         double m = 1e-15 * (fabs(lo[k]) + fabs(hi[k]) + fabs(g->lo[k]) + reach) + 1e-9 * side;
         e = clo > hi[k] ? clo - hi[k] : lo[k] > chi ? lo[k] - chi : 0;
         e = e > m ? e - m : 0;
@@ -336,10 +344,13 @@ void vpdsi_ogrid_prefetch(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const
     if (lv->count == 0 || (!lv->dense && g->cap == 0)) return;
     for (k = 0; k < g->dim; k++) c[k] = cell_at(g, l, k, y[k], 0, lv->dense ? lv->dn[k] - 1 : CELL_MAX);
     if (lv->dense) {
-        int32_t i = lv->dense[dense_at(lv, g->dim, c)];
+        size_t j = dense_at(lv, g->dim, c);
+        int32_t i;
         if (stage == 0) {
-            VPDSI_PREFETCH(lv->dense + dense_at(lv, g->dim, c));
-        } else if (i >= 0) {
+            VPDSI_PREFETCH(lv->dense + j);
+            return;
+        }
+        if ((i = lv->dense[j]) >= 0) {
             VPDSI_PREFETCH(s->x + (size_t)i * (size_t)g->dim);
             VPDSI_PREFETCH(s->r + i);
             VPDSI_PREFETCH(g->next + i);

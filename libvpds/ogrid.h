@@ -1,7 +1,8 @@
 /* The octave grid: the neighbour index of a variable radius in 1-3D. A sample of radius r is
  * filed at the level whose cell side s = 2 top * 2^-level is the smallest at or above 2r (so that
  * a reach up to r spans two cells per axis, four probes in 2D where r gave up to nine), in one
- * hash table of (level, cell) keys. A query visits, level by level, the cells within that
+ * hash table of (level, cell) keys, or, for the coarsest levels while their cells over the box
+ * are few, in an array by cell (no hashing). A query visits, level by level, the cells within that
  * level's reach (from the largest radius it holds, so no bound on L is assumed) and only the
  * levels whose bounding box it meets; near a point an L-Lipschitz sizing fills two or three
  * levels, so a query reads a few cells of each where the kd-tree walks from its root. */
@@ -19,17 +20,17 @@ typedef struct vpdsi_ogrid_level {
     uint64_t clo[3], chi[3];       /* ... in cells */
     size_t count;
     /* a level with few cells over the whole box holds its cells' first samples in an array, by
-     * cell, rather than in the table (no hashing): dn[k] cells per axis, cells in all (0: the
-     * table); a sample past the box's far side goes to its last cell, as the table's clamp does
-     * at its last coordinate */
+     * cell, rather than in the table: dn[k] cells per axis, cells in all (0: the table); a
+     * sample past the box's far side goes to its last cell (queries reach it: cell_beyond) */
     int32_t *dense;
     uint64_t dn[3];
     size_t cells;
 } vpdsi_ogrid_level;
 
 typedef struct vpdsi_ogrid {
-    int dim, levels;               /* levels in use: side >= the box extent / 2^BITS */
-    int hashed;                    /* levels past the dense ones (they file in the table) */
+    int dim, levels;               /* levels in use: side >= the box extent / 2^BITS and >= 2
+                                      bottom (vpdsi_ogrid_setup) */
+    int n_hashed;                  /* levels past the dense ones (they file in the table) */
     double lo[3];
     vpdsi_ogrid_level lv[VPDSI_OGRID_LEVELS];
     uint64_t *keys;                /* 0: empty slot; else 1 + (level, cell) */

@@ -50,6 +50,76 @@ static double dist2(const double *a, const double *b, int d)
 
 static int compared = 0, skipped = 0;
 
+/* The samples near the box [lo, hi] (r_bound rp): the kd-tree's, the hashed octave grid's and
+ * the one with arrays' are the same. mark: n bytes of scratch. */
+static void check_near_box(const char *name, const vpdsi_kdtree *t, const vpdsi_ogrid *og,
+                           const vpdsi_ogrid *ogd, const vpdsi_kd_samples *s, int n,
+                           const double *lo, const double *hi, double rp, char *mark)
+{
+    vpdsi_mem m;
+    int32_t *out = NULL;
+    size_t cnt[3] = {0, 0, 0}, cap = 0, a;
+    int which;
+    vpdsi_mem_init(&m, NULL);
+    memset(mark, 0, (size_t)n);
+    for (which = 0; which < 3; which++) {
+        size_t first = which ? cnt[which - 1] : 0;
+        cnt[which] = first;
+        if (which == 0)
+            CHECK(vpdsi_kd_near_box(t, s, lo, hi, rp, 1.0, 0, (size_t)n + 1, &m, &out, &cnt[0], &cap) == 0);
+        else
+            CHECK(vpdsi_ogrid_near_box(which == 1 ? og : ogd, s, lo, hi, rp, 1.0, &m, &out, &cnt[which],
+                                       &cap) == 0);
+        for (a = first; a < cnt[which]; a++) mark[out[a]] |= (char)(1 << which);
+        cnt[which] -= first;
+    }
+    for (a = 0; a < (size_t)n; a++)
+        if (mark[a] != 0 && mark[a] != 7) break;
+    CHECK_MSG(a == (size_t)n && cnt[0] == cnt[1] && cnt[0] == cnt[2], "%s: the samples near a box "
+              "differ (kd-tree %zu, octave grid %zu, with arrays %zu; sample %zu: %d)", name, cnt[0],
+              cnt[1], cnt[2], a, a < (size_t)n ? mark[a] : 0);
+    vpdsi_mem_free(&m, out, cap * sizeof *out);
+}
+
+/* Samples and queries past the box (a tile's neighbours, round-off): the octave grid clamps
+ * them into its first and last cells, and still finds them, hashed or in arrays. */
+static void check_past_box(void)
+{
+    static const double box_lo[2] = {0, 0}, box_hi[2] = {1, 1};
+    double x[8] = {3.0, 0.5, -2.0, 0.5, 0.5, 0.5, 0.5, 1.7}, r[4] = {0.1, 0.1, 0.1, 0.1};
+    uint8_t flags[4] = {0, 0, 0, 0};
+    vpdsi_kd_samples s;
+    vpdsi_mem m;
+    int dense, i;
+    s.x = x;
+    s.r = r;
+    s.flags = flags;
+    vpdsi_mem_init(&m, NULL);
+    for (dense = 0; dense < 2; dense++) {
+        vpdsi_ogrid g;
+        CHECK(vpdsi_ogrid_setup(&g, 2, box_lo, box_hi, 0.1, 0.1, dense ? 1e6 : 0) == 0);
+        CHECK(g.n_hashed == (dense ? 0 : 1));
+        CHECK(vpdsi_ogrid_reserve(&g, &m, 4, 4) == 0);
+        for (i = 0; i < 4; i++) vpdsi_ogrid_insert(&g, &s, i);
+        for (i = 0; i < 4; i++) {
+            double q[2] = {x[2 * i] + 0.05, x[2 * i + 1]}, lo[2], hi[2];
+            int32_t w, *out = NULL;
+            size_t cnt = 0, cap = 0;
+            int rule = VPDS_RULE_SMALLER;
+            CHECK_MSG(vpdsi_ogrid_conflict(&g, &s, q, 0.1, rule, 1.0, -1.0, &w) == i,
+                      "a query by sample %d at (%g, %g) missed it (arrays: %d)", i, x[2 * i], x[2 * i + 1], dense);
+            lo[0] = hi[0] = q[0];
+            lo[1] = hi[1] = q[1];
+            CHECK(vpdsi_ogrid_near_box(&g, &s, lo, hi, 0.1, 1.0, &m, &out, &cnt, &cap) == 0);
+            CHECK_MSG(cnt == 1 && out[0] == i, "the samples near (%g, %g): %zu (arrays: %d)", q[0], q[1],
+                      cnt, dense);
+            vpdsi_mem_free(&m, out, cap * sizeof *out);
+        }
+        vpdsi_ogrid_release(&g, &m);
+    }
+    CHECK(m.held == 0);
+}
+
 static void check_set(const char *name, int dim, int n, double *x, double *r)
 {
     vpdsi_mem m;
@@ -87,8 +157,8 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
         CHECK(vpdsi_ogrid_setup(&ogd, dim, box_lo, box_hi, rmax, rmin, 200000) == 0);
         CHECK(vpdsi_ogrid_reserve(&ogd, &m, (size_t)n, (size_t)n) == 0);
         for (i = 0; i < n; i++) vpdsi_ogrid_insert(&ogd, &s, i);
-        CHECK_MSG(ogd.levels > ogd.hashed && ogd.levels <= og.levels, "%s: %d levels, %d of them in "
-                  "arrays, against %d", name, ogd.levels, ogd.levels - ogd.hashed, og.levels);
+        CHECK_MSG(ogd.levels > ogd.n_hashed && ogd.levels <= og.levels, "%s: %d levels, %d of them in "
+                  "arrays, against %d", name, ogd.levels, ogd.levels - ogd.n_hashed, og.levels);
     }
     f.params = DEFAULT_FLANN_PARAMETERS;
     f.params.algorithm = FLANN_INDEX_KDTREE_SINGLE;
@@ -152,24 +222,7 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
             }
             half = sqrt(half);
             nf = flann_within(&f, n, c, (rmax > rp ? rmax : rp) + half);
-            if (use_og) {
-                /* the samples near the box: the kd-tree's, the grid's and the grid's with arrays */
-                size_t a;
-                cnt = cnt2 = 0;
-                CHECK(vpdsi_kd_near_box(&t, &s, lo, hi, rp, 1.0, 0, (size_t)n + 1, &m, &out, &cnt, &cap) == 0);
-                memset(mark, 0, (size_t)n);
-                for (a = 0; a < cnt; a++) mark[out[a]] |= 1;
-                CHECK(vpdsi_ogrid_near_box(&og, &s, lo, hi, rp, 1.0, &m, &out2, &cnt2, &cap2) == 0);
-                for (a = 0; a < cnt2; a++) mark[out2[a]] |= 2;
-                cnt2 = 0;
-                CHECK(vpdsi_ogrid_near_box(&ogd, &s, lo, hi, rp, 1.0, &m, &out2, &cnt2, &cap2) == 0);
-                for (a = 0; a < cnt2; a++) mark[out2[a]] |= 4;
-                for (a = 0; a < (size_t)n; a++)
-                    if (mark[a] != 0 && mark[a] != 7) break;
-                CHECK_MSG(a == (size_t)n && cnt == cnt2, "%s: the samples near a box differ (kd-tree "
-                          "%zu, octave grid with arrays %zu; sample %zu: %d)", name, cnt, cnt2, a,
-                          a < (size_t)n ? mark[a] : 0);
-            }
+            if (use_og) check_near_box(name, &t, &og, &ogd, &s, n, lo, hi, rp, mark);
             for (rule = VPDS_RULE_PRIOR; rule <= VPDS_RULE_SMALLER; rule++) {
                 int ours, ref = 0, ambiguous = 0;
                 cnt = 0;
@@ -241,6 +294,7 @@ int main(void)
 {
     static double x[NMAX * 6], r[NMAX];
     int dims[] = {1, 2, 3, 6}, di, i, k;
+    check_past_box();
     for (di = 0; di < 4; di++) {
         int d = dims[di], n = 3000;
         char name[64];
