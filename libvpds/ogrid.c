@@ -16,7 +16,7 @@ static void plan_dense(vpdsi_ogrid *g, const double *lo, const double *hi, doubl
     int k, l;
     for (l = 0; l < g->levels; l++) {
         vpdsi_ogrid_level *lv = &g->lv[l];
-        size_t cells = 1, bytes;
+        size_t cells = 1, bytes; /* bytes: only that the array's size fits a size_t */
         for (k = 0; k < 3; k++) {
             double n = k < g->dim ? floor((hi[k] - lo[k]) * lv->inv) + 1 : 1;
             if (!(n <= (double)CELL_MAX + 1) || vpdsi_mul_size(cells, (size_t)n, &cells)) break;
@@ -266,9 +266,9 @@ static int cell_beyond(const vpdsi_ogrid *g, int l, const uint64_t *c, const dou
     int k;
     for (k = 0; k < g->dim; k++) {
         double clo = g->lo[k] + (double)c[k] * side, chi = clo + side, e;
+        double m = 1e-15 * (fabs(lo[k]) + fabs(hi[k]) + fabs(g->lo[k]) + reach) + 1e-9 * side;
         if (c[k] == 0 && lv->lo[k] < clo) clo = lv->lo[k];
         if (c[k] == (lv->dense ? lv->dn[k] - 1 : CELL_MAX) && lv->hi[k] > chi) chi = lv->hi[k];
-        double m = 1e-15 * (fabs(lo[k]) + fabs(hi[k]) + fabs(g->lo[k]) + reach) + 1e-9 * side;
         e = clo > hi[k] ? clo - hi[k] : lo[k] > chi ? lo[k] - chi : 0;
         e = e > m ? e - m : 0;
         s += e * e;

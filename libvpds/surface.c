@@ -200,7 +200,7 @@ static vpds_status seed_radius(const vpdsi_surface_ctx *ctx, uint32_t k, double 
 /* Index the samples: the octave grid when the largest radius is known, else the kd-tree. Its
  * levels stop at the least radius (vertex radii interpolate between their vertices'); the
  * coarsest go in arrays while their cells over the mesh's box are few beside the samples
- * expected (a flat or gently curved mesh; a sphere's box has 30 times too many). */
+ * expected (a flat or gently curved mesh; the unit sphere's box at r = 0.01 has 12 per sample). */
 static vpds_status choose_sample_index(const vpdsi_surface *s, const vpdsi_surface_ctx *ctx)
 {
     const vpdsi_trimesh *mesh = ctx->mesh;
