@@ -161,6 +161,13 @@ static uint64_t key_of(int l, const uint64_t *c, int dim)
     return key + 1;
 }
 
+/* The last cell coordinate on axis k, where the clamp puts samples past it: the array's last,
+ * or the table's key's. */
+static uint64_t last_cell(const vpdsi_ogrid_level *lv, int k)
+{
+    return lv->dense ? lv->dn[k] - 1 : CELL_MAX;
+}
+
 /* Where a dense level keeps cell c (dim coordinates). */
 static size_t dense_at(const vpdsi_ogrid_level *lv, int dim, const uint64_t *c)
 {
@@ -185,7 +192,7 @@ void vpdsi_ogrid_insert(vpdsi_ogrid *g, const vpdsi_kd_samples *s, int32_t i)
     uint64_t c[3] = {0, 0, 0};
     size_t j;
     for (k = 0; k < g->dim; k++) {
-        c[k] = cell_at(g, l, k, x[k], 0, lv->dense ? lv->dn[k] - 1 : CELL_MAX);
+        c[k] = cell_at(g, l, k, x[k], 0, last_cell(lv, k));
         if (lv->count == 0 || x[k] < lv->lo[k]) lv->lo[k] = x[k];
         if (lv->count == 0 || x[k] > lv->hi[k]) lv->hi[k] = x[k];
         if (lv->count == 0 || c[k] < lv->clo[k]) lv->clo[k] = c[k];
@@ -268,7 +275,7 @@ static int cell_beyond(const vpdsi_ogrid *g, int l, const uint64_t *c, const dou
         double clo = g->lo[k] + (double)c[k] * side, chi = clo + side, e;
         double m = 1e-15 * (fabs(lo[k]) + fabs(hi[k]) + fabs(g->lo[k]) + reach) + 1e-9 * side;
         if (c[k] == 0 && lv->lo[k] < clo) clo = lv->lo[k];
-        if (c[k] == (lv->dense ? lv->dn[k] - 1 : CELL_MAX) && lv->hi[k] > chi) chi = lv->hi[k];
+        if (c[k] == last_cell(lv, k) && lv->hi[k] > chi) chi = lv->hi[k];
         e = clo > hi[k] ? clo - hi[k] : lo[k] > chi ? lo[k] - chi : 0;
         e = e > m ? e - m : 0;
         s += e * e;
@@ -342,7 +349,7 @@ void vpdsi_ogrid_prefetch(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const
     uint64_t c[3], key;
     size_t j;
     if (lv->count == 0 || (!lv->dense && g->cap == 0)) return;
-    for (k = 0; k < g->dim; k++) c[k] = cell_at(g, l, k, y[k], 0, lv->dense ? lv->dn[k] - 1 : CELL_MAX);
+    for (k = 0; k < g->dim; k++) c[k] = cell_at(g, l, k, y[k], 0, last_cell(lv, k));
     if (lv->dense) {
         size_t j = dense_at(lv, g->dim, c);
         int32_t i;
