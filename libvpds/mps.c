@@ -49,8 +49,10 @@ void vpdsi_mps_release(vpdsi_mps *m, vpdsi_store *st)
     vpdsi_mem_free(st->mem, m->cand_tag, m->cap_cand_tag * sizeof(uint16_t));
     vpdsi_mem_free(st->mem, m->strip.idx, m->strip.cap * sizeof(int32_t));
     vpdsi_mem_free(st->mem, m->base.idx, m->base.cap * sizeof(int32_t));
+    vpdsi_mem_free(st->mem, m->group.idx, m->group.cap * sizeof(int32_t));
     memset(&m->strip, 0, sizeof m->strip);
     memset(&m->base, 0, sizeof m->base);
+    memset(&m->group, 0, sizeof m->group);
     vpdsi_mem_free(st->mem, m->buf_x, m->cap_buf_x * sizeof(double));
     vpdsi_mem_free(st->mem, m->buf_r, m->cap_buf_r * sizeof(double));
     vpdsi_mem_free(st->mem, m->buf_u, m->cap_buf_u * sizeof(double));
@@ -776,6 +778,50 @@ static const vpdsi_near_list *near_lists(vpdsi_mps *m, const vpdsi_ctx *ctx, con
     return &m->base;
 }
 
+#ifndef GROUP_UP
+#define GROUP_UP 2
+#endif
+/* The octave grid: the samples near the ancestor of cell c GROUP_UP levels up, searched once
+ * while the cells under it are swept one after another (on the ramp 4.4 of them), for cells of
+ * r_hi <= r_bound (near_bound). It holds every sample a cell's gather lists: a sample that may
+ * cover a child of the cell lies within scale * f <= scale * max(r(x), r_bound) of the cell,
+ * so of the ancestor, grown by a margin for the round-off of far coordinates. */
+static const vpdsi_near_list *group_list(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t *c,
+                                         unsigned level, double scale, double r_hi)
+{
+    vpdsi_store *st = ctx->st;
+    int d = ctx->pb->dim, k;
+    int same = m->group.key && m->group.store_n == st->n && m->group_level == level && r_hi <= m->group.r_bound;
+    uint64_t a[3];
+    double lo[3], hi[3], rb;
+    vpdsi_kd_samples view;
+    for (k = 0; k < d; k++) {
+        a[k] = c[k] >> GROUP_UP;
+        same = same && a[k] == m->group_c[k];
+    }
+    if (same) return &m->group;
+    vpdsi_lattice_box(&m->run.geom, level - GROUP_UP, a, lo, hi);
+    rb = near_bound(st, r_hi, d, lo, hi);
+    for (k = 0; k < d; k++) {
+        double margin = 1e-14 * (fabs(lo[k]) + fabs(hi[k]) + scale * rb);
+        lo[k] -= margin;
+        hi[k] += margin;
+    }
+    m->group.key = 0;
+    m->group.n = 0;
+    view = vpdsi_store_view(st);
+    if (vpdsi_ogrid_near_rule(&st->ogrid, &view, lo, hi, rb, (int)ctx->pb->rule, scale, ctx->mem, &m->group.idx,
+                              &m->group.n, &m->group.cap) < 0 ||
+        vpdsi_mem_reserve(ctx->mem, (void **)&m->cand, &m->cap_cand, m->group.n, sizeof(int32_t)))
+        return NULL;
+    m->group.key = 1;
+    m->group.store_n = st->n;
+    m->group.r_bound = rb;
+    m->group_level = level;
+    memcpy(m->group_c, a, (size_t)d * sizeof *a);
+    return &m->group;
+}
+
 /* The samples that may cover part of cell c ([lo, hi], r <= r_hi over it) into m->cand. */
 static vpds_status gather_near(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t *c,
                                unsigned level, const double *lo, const double *hi, double r_hi,
@@ -831,6 +877,12 @@ static vpds_status gather_near(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_
             m->n_cand = vpdsi_kd_list_gather(&st->tree, &view, near->idx, near->n, lo, hi, r_hi,
                                              (int)pb->rule, scale, split, m->cand);
         }
+    } else if (level >= GROUP_UP) { /* the octave grid, below the base cells' children */
+        vpdsi_kd_samples view = vpdsi_store_view(st);
+        const vpdsi_near_list *group = group_list(m, ctx, c, level, scale, r_hi);
+        if (!group) goto oom;
+        m->n_cand = vpdsi_kd_list_gather(&st->tree, &view, group->idx, group->n, lo, hi, r_hi,
+                                         (int)pb->rule, scale, split, m->cand);
     } else if (vpdsi_store_gather(st, lo, hi, r_hi, (int)pb->rule, scale, split, &m->cand,
                                   &m->n_cand, &m->cap_cand)) {
         goto oom;
@@ -1120,7 +1172,7 @@ static void begin_sweep(vpdsi_mps *m, const vpdsi_ctx *ctx, int split)
         vpdsi_cells_layout(&m->run.next, ctx->pb->dim, m->run.geom.n0, cur_level(m) + (split ? 1u : 0u));
     m->run.pos = 0;
     m->unc.n_nwit = 0; /* the witness records of this sweep's flagged cells */
-    m->strip.key = m->base.key = 0; /* new samples, and with a new scale new base cells */
+    m->strip.key = m->base.key = m->group.key = 0; /* new samples, and with a new scale new base cells */
 }
 
 /* One chunk of the sweep (or the filter) of at most limit cells; *done: work units spent. */

@@ -54,6 +54,11 @@ typedef struct vpdsi_mps {
     vpdsi_near_list strip, base;            /* the samples near the cells being swept (the
                                                background grid: base's key and store_n name
                                                the base cell cand holds) */
+    vpdsi_near_list group;                  /* octave grid: the samples near the ancestor
+                                               group_c at group_level - GROUP_UP of the cells
+                                               being swept (mps.c group_list) */
+    uint64_t group_c[3];
+    unsigned group_level;
 } vpdsi_mps;
 
 /* What one call may spend and whom it tells. */

@@ -74,4 +74,10 @@ void vpdsi_ogrid_prefetch(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const
 int vpdsi_ogrid_near_box(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const double *lo,
                          const double *hi, double r_bound, double scale, vpdsi_mem *m,
                          int32_t **out, size_t *count, size_t *cap);
+/* The samples within scale * f(r(x), r_bound) of the box [lo, hi] (f of the rule, widened by
+ * 1e-9): every one that may cover a part of it for a point of r <= r_bound there, appended to
+ * *out; -1 on OOM. */
+int vpdsi_ogrid_near_rule(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const double *lo,
+                          const double *hi, double r_bound, int rule, double scale, vpdsi_mem *m,
+                          int32_t **out, size_t *count, size_t *cap);
 #endif

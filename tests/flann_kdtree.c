@@ -120,6 +120,63 @@ static void check_past_box(void)
     CHECK(m.held == 0);
 }
 
+/* The samples within f(r(x), rp) of the box [lo, hi] by the octave grid (hashed: which 0, with
+ * arrays: 1; vpdsi_ogrid_near_rule, the sweep's list for the cells under an ancestor) are FLANN's
+ * (ids[0..nf), a superset) at that distance, and hold every sample its gather lists for the
+ * box and for any box inside it (split or not): the sweep filters them for each cell. mark: n
+ * zero bytes of scratch, left zero. */
+static void check_near_rule(const char *name, const vpdsi_ogrid *og, const vpdsi_kd_samples *s, int dim,
+                            const int *ids, int nf, const double *lo, const double *hi, double rp, int rule,
+                            char *mark, int which)
+{
+    vpdsi_mem m;
+    int32_t *out = NULL;
+    size_t cnt = 0, cap = 0, a;
+    double ilo[3], ihi[3];
+    int j, k, split;
+    vpdsi_mem_init(&m, NULL);
+    for (k = 0; k < dim; k++) { /* a box inside: its lower three quarters */
+        ilo[k] = lo[k];
+        ihi[k] = lo[k] + 0.75 * (hi[k] - lo[k]);
+    }
+    for (split = 0; split < 4; split++) /* the box and the one inside, split or not */
+        CHECK(vpdsi_ogrid_gather(og, s, split < 2 ? lo : ilo, split < 2 ? hi : ihi, rp, rule, 1.0, split % 2,
+                                 &m, &out, &cnt, &cap) == 0);
+    for (a = 0; a < cnt; a++) mark[out[a]] = 8;
+    cnt = 0;
+    CHECK(vpdsi_ogrid_near_rule(og, s, lo, hi, rp, rule, 1.0, &m, &out, &cnt, &cap) == 0);
+    for (a = 0; a < cnt; a++) mark[out[a]] |= 16;
+    for (j = 0; j < nf; j++) {
+        const double *x = s->x + (size_t)ids[j] * (size_t)dim;
+        double fr = vpdsi_rule_f((vpds_rule)rule, s->r[ids[j]], rp), g2 = 0;
+        int listed = (mark[ids[j]] & 16) != 0;
+        for (k = 0; k < dim; k++) {
+            double e = x[k] < lo[k] ? lo[k] - x[k] : x[k] > hi[k] ? x[k] - hi[k] : 0;
+            g2 += e * e;
+        }
+        if (!in_band(g2, fr))
+            CHECK_MSG(listed == (g2 <= fr * fr), "%s: octave grid (arrays: %d) near_rule (rule %d) %s "
+                      "sample %d at %g of the box, reach %g", name, which, rule, listed ? "lists" : "misses",
+                      ids[j], sqrt(g2), fr);
+        CHECK_MSG(listed || !(mark[ids[j]] & 8), "%s: octave grid (arrays: %d) near_rule (rule %d) misses "
+                  "sample %d that the gather lists", name, which, rule, ids[j]);
+    }
+    for (a = 0; a < cnt; a++) { /* and each it lists is near (FLANN's radius is a float) */
+        const double *x = s->x + (size_t)out[a] * (size_t)dim;
+        double fr = vpdsi_rule_f((vpds_rule)rule, s->r[out[a]], rp), g2 = 0;
+        for (k = 0; k < dim; k++) {
+            double e = x[k] < lo[k] ? lo[k] - x[k] : x[k] > hi[k] ? x[k] - hi[k] : 0;
+            g2 += e * e;
+        }
+        CHECK_MSG(g2 <= fr * fr * (1 + 1e-6), "%s: near_rule lists sample %d at %g of the box, reach %g", name,
+                  (int)out[a], sqrt(g2), fr);
+    }
+    for (j = 0; j < nf; j++) mark[ids[j]] = 0;
+    for (a = 0; a < cnt; a++) mark[out[a]] = 0;
+    vpdsi_mem_free(&m, out, cap * sizeof *out);
+    CHECK(m.held == 0);
+}
+
 static void check_set(const char *name, int dim, int n, double *x, double *r)
 {
     vpdsi_mem m;
@@ -261,6 +318,9 @@ static void check_set(const char *name, int dim, int n, double *x, double *r)
                                   "gathers other samples (rule %d, split %d): %zu against %zu", name,
                                   rule, split, cnt2, cnt);
                     }
+                    memset(mark, 0, (size_t)n);
+                    check_near_rule(name, &og, &s, dim, f.idx, nf, lo, hi, rp, rule, mark, 0);
+                    check_near_rule(name, &ogd, &s, dim, f.idx, nf, lo, hi, rp, rule, mark, 1);
                     cnt = 0;
                     CHECK(vpdsi_kd_gather(&t, &s, lo, hi, rp, rule, 1.0, 0, &m, &out, &cnt, &cap) == 0);
                 }
