@@ -783,9 +783,9 @@ static const vpdsi_near_list *near_lists(vpdsi_mps *m, const vpdsi_ctx *ctx, con
 #endif
 /* The octave grid: the samples near the ancestor of cell c GROUP_UP levels up, searched once
  * while the cells under it are swept one after another (on the ramp 4.4 of them), for cells of
- * r_hi <= r_bound (near_bound). It holds every sample a cell's gather lists: a sample that may
- * cover a child of the cell lies within scale * f <= scale * max(r(x), r_bound) of the cell,
- * so of the ancestor, grown by a margin for the round-off of far coordinates. */
+ * r_hi <= r_bound (near_bound). It holds every sample a cell's gather lists: one that may cover
+ * a child of the cell lies within scale * f(r(x), r_hi) <= scale * f(r(x), r_bound) of the
+ * cell, so of the ancestor, grown by a margin for the round-off of far coordinates. */
 static const vpdsi_near_list *group_list(vpdsi_mps *m, const vpdsi_ctx *ctx, const uint64_t *c,
                                          unsigned level, double scale, double r_hi)
 {

@@ -468,25 +468,8 @@ int vpdsi_ogrid_gathers(const vpdsi_kd_samples *s, int dim, int32_t i, const dou
     return vpdsi_prox_may_cover(s, i, dim, open_axes, c0, c1, w, r_hi, rule, scale);
 }
 
-/* Whether sample i lies within lim(r(x)) of the box [lo, hi]: vpdsi_prox_near's test with
- * rule < 0, else within scale * f(r(x), r_bound) * (1 + 1e-9). */
-static int near_test(const vpdsi_kd_samples *s, int32_t i, int dim, const double *lo, const double *hi,
-                     double r_bound, int rule, double scale)
-{
-    const double *x;
-    double lim, g2 = 0;
-    int k;
-    if (rule < 0) return vpdsi_prox_near(s, i, dim, open_axes, lo, hi, r_bound, scale, 0);
-    x = s->x + (size_t)i * (size_t)dim;
-    lim = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_bound) * (1 + 1e-9);
-    for (k = 0; k < dim; k++) {
-        double e = vpdsi_axis_gap(x[k], lo[k], hi[k], 0.0);
-        g2 += e * e;
-    }
-    return !(g2 > lim * lim);
-}
-
-/* The samples near the box [lo, hi] by near_test, appended to *out; -1 on OOM. */
+/* The samples near the box [lo, hi] by vpdsi_prox_near (rule < 0) or vpdsi_prox_near_rule,
+ * appended to *out; -1 on OOM. */
 static int near_walk(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const double *lo, const double *hi,
                      double r_bound, int rule, double scale, vpdsi_mem *m, int32_t **out, size_t *count,
                      size_t *cap)
@@ -507,7 +490,9 @@ static int near_walk(const vpdsi_ogrid *g, const vpdsi_kd_samples *s, const doub
         while (next_range_cell(g, l, a, b, scan, c, &pos, &i)) {
             if (i < 0 || cell_beyond(g, l, c, lo, hi, reach)) continue;
             for (; i >= 0; i = g->next[i]) {
-                if (!near_test(s, i, g->dim, lo, hi, r_bound, rule, scale)) continue;
+                if (rule < 0 ? !vpdsi_prox_near(s, i, g->dim, open_axes, lo, hi, r_bound, scale, 0)
+                             : !vpdsi_prox_near_rule(s, i, g->dim, open_axes, lo, hi, r_bound, rule, scale))
+                    continue;
                 if (*count == *cap && vpdsi_mem_reserve(m, (void **)out, cap, *count + 1, sizeof **out))
                     return -1;
                 (*out)[(*count)++] = i;

@@ -24,6 +24,24 @@ static inline int vpdsi_prox_near(const vpdsi_kd_samples *s, int32_t i, int dim,
     return 1;
 }
 
+/* Near under a rule (vpdsi_ogrid_near_rule): |x - box| <= scale * f(r(x), r_bound) * (1 + 1e-9),
+ * which every sample that may cover a part of the box for a point of r <= r_bound passes (f
+ * grows with r at the point under every rule). */
+static inline int vpdsi_prox_near_rule(const vpdsi_kd_samples *s, int32_t i, int dim, const double *period,
+                                       const double *lo, const double *hi, double r_bound, int rule,
+                                       double scale)
+{
+    const double *x = s->x + (size_t)i * (size_t)dim;
+    double lim = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_bound) * (1 + 1e-9), g2 = 0;
+    int k;
+    for (k = 0; k < dim; k++) {
+        double e = vpdsi_axis_gap(x[k], lo[k], hi[k], period[k]);
+        g2 += e * e;
+        if (g2 > lim * lim) return 0; /* the sum only grows */
+    }
+    return 1;
+}
+
 /* Sample i against the dart y of radius ry: 1 when it conflicts (|y - x| < scale f), -2 when
  * (lipschitz >= 0) its radius follows the sizing and breaks |r(x) - ry| <= L |x - y|, else 0. */
 static inline int vpdsi_prox_conflict(const vpdsi_kd_samples *s, int32_t i, int dim,
