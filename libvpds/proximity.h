@@ -7,13 +7,12 @@
 #include "samples.h"
 #include "torus.h"
 
-/* Near (vpdsi_kd_near_box): |x - box| <= scale * max(r(x), r_bound) * (1 + 1e-9) + slack. */
-static inline int vpdsi_prox_near(const vpdsi_kd_samples *s, int32_t i, int dim, const double *period,
-                                  const double *lo, const double *hi, double r_bound, double scale,
-                                  double slack)
+/* Whether sample i lies within lim of the box [lo, hi] (nearest image on a periodic axis): the
+ * loop the near tests below share, each with its own lim. */
+static inline int vpdsi_prox_within(const vpdsi_kd_samples *s, int32_t i, int dim, const double *period,
+                                    const double *lo, const double *hi, double lim)
 {
     const double *x = s->x + (size_t)i * (size_t)dim;
-    double r = s->r[i], lim = scale * (r > r_bound ? r : r_bound) * (1 + 1e-9) + slack;
     double lim2 = lim * lim, g2 = 0;
     int k;
     for (k = 0; k < dim; k++) {
@@ -24,6 +23,15 @@ static inline int vpdsi_prox_near(const vpdsi_kd_samples *s, int32_t i, int dim,
     return 1;
 }
 
+/* Near (vpdsi_kd_near_box): |x - box| <= scale * max(r(x), r_bound) * (1 + 1e-9) + slack. */
+static inline int vpdsi_prox_near(const vpdsi_kd_samples *s, int32_t i, int dim, const double *period,
+                                  const double *lo, const double *hi, double r_bound, double scale,
+                                  double slack)
+{
+    double r = s->r[i];
+    return vpdsi_prox_within(s, i, dim, period, lo, hi, scale * (r > r_bound ? r : r_bound) * (1 + 1e-9) + slack);
+}
+
 /* Near under a rule (vpdsi_ogrid_near_rule): |x - box| <= scale * f(r(x), r_bound) * (1 + 1e-9),
  * which every sample that may cover a part of the box for a point of r <= r_bound passes (f
  * grows with r at the point under every rule). */
@@ -31,15 +39,8 @@ static inline int vpdsi_prox_near_rule(const vpdsi_kd_samples *s, int32_t i, int
                                        const double *lo, const double *hi, double r_bound, int rule,
                                        double scale)
 {
-    const double *x = s->x + (size_t)i * (size_t)dim;
-    double lim = scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_bound) * (1 + 1e-9), g2 = 0;
-    int k;
-    for (k = 0; k < dim; k++) {
-        double e = vpdsi_axis_gap(x[k], lo[k], hi[k], period[k]);
-        g2 += e * e;
-        if (g2 > lim * lim) return 0; /* the sum only grows */
-    }
-    return 1;
+    return vpdsi_prox_within(s, i, dim, period, lo, hi,
+                             scale * vpdsi_rule_f((vpds_rule)rule, s->r[i], r_bound) * (1 + 1e-9));
 }
 
 /* Sample i against the dart y of radius ry: 1 when it conflicts (|y - x| < scale f), -2 when
