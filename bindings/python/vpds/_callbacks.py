@@ -42,6 +42,8 @@ class CallbackResultError(ValueError):
 def as_values(out: Any, n: int, what: str, flat: bool = False) -> npt.NDArray[np.float64]:
     """A callable's result as n float64 values (flat: of any shape holding n values), else a
     CallbackResultError saying why."""
+    if out is None:  # np.asarray(None, float) is NaN: say what came back instead
+        raise CallbackResultError(f"{what} returned None, not numbers (a missing return?)")
     try:
         v = np.asarray(out, dtype=np.float64)
     except (TypeError, ValueError) as exc:
@@ -107,6 +109,8 @@ def raise_failure(status: int, message: str, cause: Optional[BaseException], whe
             cause.add_note(f"(raised in the {where} callable, called by libvpds: {name}: {message})")
         raise cause
     if cause is not None:
+        # the binding answered NaN to stop the library: its "returned NaN" was not the callable's
+        message = message.replace(f"{where} returned NaN at", f"{where} called at", 1)
         message = f"{message}: {cause}" if message else str(cause)
     _raise(status, message, cause)
     raise AssertionError("unreachable")  # _raise always raises

@@ -7,6 +7,8 @@ from typing import Any, Callable, Iterator, NamedTuple, Optional, Sequence, Supp
 import numpy as np
 import numpy.typing as npt
 
+from ._args import axis_flags, number, room_for_samples, tile_counts
+from ._args import count as count_arg
 from ._callbacks import as_values, escaped, keep, raise_failure, take
 from ._errors import (VpdsDomainError, VpdsError, VpdsSizingError, VpdsStateError,
                       VpdsUnsupportedError, VpdsValueError, _raise, created)
@@ -58,12 +60,22 @@ def vpds_py_sizing_batch(x: Any, n: int, r_out: Any, user: Any) -> int:
         if owner._callback_error is not None:
             return 1
         pts = np.frombuffer(ffi.buffer(x, n * owner.d * 8), dtype=np.float64).reshape(n, owner.d)
+        pts.flags.writeable = False  # the library's own darts: a sizing that wrote them moved them
         r = as_values(owner._sizing_fn(pts), n, "sizing")
         np.frombuffer(ffi.buffer(r_out, n * 8), dtype=np.float64)[:] = r
         return 0
     except BaseException as exc:  # noqa: BLE001 - re-raised in Python after the C call returns
         keep(user, "_callback_error", exc)
         return 1
+
+
+def _grid_shape(shape: Any, d: int) -> tuple[int, ...]:
+    """sizing_grid_shape as d node counts >= 2 (the grid's ends are the box's)."""
+    values = list(shape) if isinstance(shape, (list, tuple, np.ndarray)) else None
+    if values is None or len(values) != d or not all(
+            isinstance(m, (int, np.integer)) and not isinstance(m, bool) and m >= 2 for m in values):
+        raise ValueError(f"sizing_grid_shape = {shape!r}: give d = {d} integers >= 2, the nodes per axis")
+    return tuple(int(m) for m in values)
 
 
 class Progressive(NamedTuple):
@@ -200,7 +212,7 @@ class PoissonDisk:
                                  "move samples without regard to it (random-cd swaps "
                                  "coordinates, lloyd moves to centroids in the box)")
             self._select_optimizer = _scipy_optimizers(self.optimization)
-        self.radius = float(radius)
+        self.radius = number("radius", radius, " (radii that vary: sizing=)")
         self.rule = rule
         self.progress = progress
         self._seed = _seed_from(seed if seed is not None else rng)
@@ -216,7 +228,7 @@ class PoissonDisk:
         desc.lo, desc.hi = lo, hi
         self._keep += [lo, hi]
         if periodic is not None:
-            per = ffi.new("int[]", [1 if p else 0 for p in periodic])
+            per = ffi.new("int[]", axis_flags("periodic", periodic, self.d))
             desc.periodic = per
             self._keep.append(per)
         desc.radius = self.radius
@@ -228,12 +240,10 @@ class PoissonDisk:
             if not callable(sizing):
                 raise ValueError("sizing_grid_shape samples a callable sizing onto a grid; "
                                  f"sizing is {type(sizing).__name__}")
-            axes = [np.linspace(a, b, int(m)) for a, b, m in
-                    zip(self.l_bounds, self.u_bounds, sizing_grid_shape)]
-            if len(axes) != self.d:
-                raise ValueError(f"sizing_grid_shape has {len(axes)} values for d = {self.d}")
+            shape = _grid_shape(sizing_grid_shape, self.d)
+            axes = [np.linspace(a, b, m) for a, b, m in zip(self.l_bounds, self.u_bounds, shape)]
             nodes = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, self.d)
-            values = np.asarray(sizing(nodes), dtype=np.float64).reshape(tuple(int(m) for m in sizing_grid_shape))
+            values = as_values(sizing(nodes), len(nodes), "sizing", flat=True).reshape(shape)
             sizing = SizingGrid(values, self.l_bounds, self.u_bounds)
             lipschitz = None  # the grid's own, exact L replaces the callable's
         if sizing is not None and not callable(sizing) and np.ndim(sizing) == 0:
@@ -241,6 +251,10 @@ class PoissonDisk:
             desc.radius = float(cast(SupportsFloat, sizing))
             self.radius = float(cast(SupportsFloat, sizing))
         elif isinstance(sizing, SizingGrid) or (sizing is not None and not callable(sizing)):
+            n_axes = sizing.dim if isinstance(sizing, SizingGrid) else np.ndim(sizing)
+            if n_axes != self.d:
+                raise ValueError(f"sizing: a grid of {n_axes} axes for d = {self.d} (one axis of "
+                                 "nodes per dimension)")
             grid = sizing if isinstance(sizing, SizingGrid) else SizingGrid(sizing, self.l_bounds, self.u_bounds)
             if enforce_lipschitz is not None:
                 grid.enforce_lipschitz(enforce_lipschitz)
@@ -252,10 +266,12 @@ class PoissonDisk:
             desc.sizing_batch = lib.vpds_py_sizing_batch
             desc.sizing_user = self._handle
         if lipschitz is not None:
-            desc.lipschitz = float(lipschitz)
+            desc.lipschitz = number("lipschitz", lipschitz)
+            if not desc.lipschitz >= 0:  # -1 would read as the C library's "not given"
+                raise ValueError(f"lipschitz = {lipschitz!r}: must be >= 0")
         desc.rule = RULES[rule]
-        desc.inhibition = float(inhibition)
-        desc.coverage = float(coverage)
+        desc.inhibition = number("inhibition", inhibition)
+        desc.coverage = number("coverage", coverage)
         desc.weighted = 1 if weighted else 0
         desc.algorithm_version = _algorithm_version(algorithm_version, 1)
         if memory_limit is not None and (not isinstance(memory_limit, (int, np.integer))
@@ -264,13 +280,13 @@ class PoissonDisk:
                              "(0 or None: no limit)")
         self._memory_limit = 0 if memory_limit is None else int(memory_limit)
         if radius_min is not None:
-            desc.radius_min = float(radius_min)
+            desc.radius_min = number("radius_min", radius_min)
         if radius_max is not None:
-            desc.radius_max = float(radius_max)
+            desc.radius_max = number("radius_max", radius_max)
         self._domain: Optional[Domain] = None
         if domain is not None:
             self._domain = as_domain(domain, self.d, self.l_bounds, self.u_bounds,
-                                     float(domain_threshold))
+                                     number("domain_threshold", domain_threshold))
             desc.domain = self._domain.fn_ptr
             desc.domain_user = self._domain.user
         desc.seed = self._seed
@@ -284,16 +300,14 @@ class PoissonDisk:
                 _raise(st, ffi.string(msg).decode())
         self._periodic = None if periodic is None else tuple(bool(p) for p in periodic)
         self.workers = check_workers(workers)
+        if tiles is not None and not (isinstance(tiles, str) and tiles == "auto"):
+            tiles = tile_counts("tiles", tiles, self.d)
         self.tiles: TilesLike = "auto" if tiles is None and self.workers != 1 else tiles
         self._check_tiled(domain, fixed_points, memory_limit, algorithm_version)
         self._tiled: Optional[tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], int, int]] = None
         self._fixed = None
         if fixed_points is not None:
-            fx = np.ascontiguousarray(fixed_points, dtype=np.float64).reshape(-1, self.d)
-            fr = None if fixed_radii is None else np.ascontiguousarray(fixed_radii, dtype=np.float64).reshape(-1)
-            if fr is not None and fr.shape != (len(fx),):
-                raise ValueError(f"fixed_radii has {fr.shape[0]} values for {len(fx)} fixed points")
-            self._fixed = (fx, fr)
+            self._fixed = self._points_and_radii("fixed_points", fixed_points, "fixed_radii", fixed_radii)
         self.reset()
 
     def _check_tiled(self, domain: Any, fixed_points: Any, memory_limit: Any,
@@ -413,11 +427,7 @@ class PoissonDisk:
 
     def _draw(self, n: Union[int, float]) -> npt.NDArray[np.float64]:
         """The next n samples as drawn (fewer if the set becomes maximal first)."""
-        if isinstance(n, (float, np.floating)) and not float(n).is_integer():
-            raise ValueError(f"n = {n!r}: must be an integer number of samples (or inf)")
-        n = int(n)
-        if n < 0:
-            raise ValueError(f"n = {n}: must be >= 0")
+        n = count_arg("n", n)
         if self._s is None:  # d = 0: scipy's n rows of no coordinates
             self.num_generated += n
             return np.empty((n, 0))
@@ -486,7 +496,7 @@ class PoissonDisk:
         """Discrete decrease (Section 4.3): maximal at the smaller scale t; returns the new
         samples, shape (m, d). After an exception (Ctrl-C, a raising callable), refine(t) again
         continues the refinement and returns all its samples, those of the stopped call included."""
-        t = float(t)
+        t = number("t", t)
         before = int(lib.vpds_count(self._sampler("refine()")))
         if self.tiles is not None:
             refuse_with_tiles(self, "refine()")
@@ -531,10 +541,9 @@ class PoissonDisk:
         point is a corner of the box); the default 0.5 draws each point at random among those
         free at t * R_f that cover the farthest point, as in the paper's Figure 7 (Delaunay
         angles >= 14.48 deg). None keeps the sampler's own inhibition."""
-        n = int(n)
-        if n < 0:
-            raise ValueError(f"n = {n}: must be >= 0")
+        n = count_arg("n", n)
         self._sampler("progressive()")
+        room_for_samples(f"progressive(n={n})", n, self.d, self._memory_limit)
         if self.tiles is not None:
             refuse_with_tiles(self, "progressive()")
         desc = ffi.new("vpds_desc *", self._desc[0])
@@ -568,14 +577,27 @@ class PoissonDisk:
         self._sampler("add_points()")
         if self.tiles is not None:
             refuse_with_tiles(self, "add_points()")
-        fx = np.ascontiguousarray(x, dtype=np.float64).reshape(-1, self.d)
-        fr = None if r is None else np.ascontiguousarray(r, dtype=np.float64).reshape(-1)
-        if fr is not None and fr.shape != (len(fx),):
-            raise ValueError(f"r has {fr.shape[0]} values for {len(fx)} points")
+        fx, fr = self._points_and_radii("x", x, "r", r)
         self._check(lib.vpds_add_points(self._s, ffi.cast("const double *", ffi.from_buffer(fx)),
                                         ffi.NULL if fr is None else ffi.cast("const double *", ffi.from_buffer(fr)),
                                         len(fx)))
         self.num_generated = int(lib.vpds_count(self._s))
+
+    def _points_and_radii(self, x_name: str, x: npt.ArrayLike, r_name: str,
+                          r: Optional[npt.ArrayLike]) -> tuple[npt.NDArray[np.float64], Optional[npt.NDArray[np.float64]]]:
+        """Points of shape (k, d) (one point: (d,)) and radii (k,) or None, as C reads them."""
+        try:
+            fx = np.ascontiguousarray(x, dtype=np.float64)
+            fr = None if r is None else np.ascontiguousarray(r, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"{x_name}, {r_name}: not arrays of numbers ({exc})") from None
+        if fx.ndim == 1 and len(fx) == self.d:
+            fx = fx.reshape(1, self.d)
+        if fx.ndim != 2 or fx.shape[1] != self.d:
+            raise ValueError(f"{x_name}: shape {fx.shape}, expected (k, {self.d}) (or ({self.d},) for one point)")
+        if fr is not None and fr.shape != (len(fx),) and not (fr.ndim == 0 and len(fx) == 1):
+            raise ValueError(f"{r_name}: shape {fr.shape}, expected ({len(fx)},): one radius per point")
+        return fx, None if fr is None else fr.reshape(-1)
 
     # -- results (copies) -----------------------------------------------------------------------
     def _count(self) -> int:

@@ -20,6 +20,7 @@ from typing import Any, Optional, Protocol, Sequence, Union
 import numpy as np
 import numpy.typing as npt
 
+from ._args import number
 from ._callbacks import as_values, escaped, keep
 from ._errors import created
 from ._typing import BoundsLike, DomainFunction
@@ -44,10 +45,11 @@ def estimate_radius(n: int, d: int, volume: float = 1.0) -> float:
     """The radius r at which a maximal uniform sampling of a domain of this volume holds about
     n points: n * volume_of_ball(r / 2) = JAMMING_DENSITY[d] * volume. An estimate: boundaries
     add points (more so for small n and thin domains), and two radii or a sizing change it."""
-    if not 1 <= d <= int(lib.VPDS_MAX_DIM):
-        raise ValueError(f"d = {d}: must be in 1..{lib.VPDS_MAX_DIM}")
-    if not n >= 1:
+    if isinstance(d, bool) or not isinstance(d, (int, np.integer)) or not 1 <= d <= int(lib.VPDS_MAX_DIM):
+        raise ValueError(f"d = {d!r}: must be in 1..{lib.VPDS_MAX_DIM} (an int)")
+    if not number("n", n) >= 1:
         raise ValueError(f"n = {n}: must be >= 1")
+    volume = number("volume", volume)
     if not volume > 0 or not math.isfinite(volume):
         raise ValueError(f"volume = {volume}: must be finite and > 0")
     unit_ball = math.pi ** (d / 2) / math.gamma(d / 2 + 1)

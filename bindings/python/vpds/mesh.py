@@ -19,6 +19,7 @@ from typing import Any, NamedTuple, Optional, Union
 import numpy as np
 import numpy.typing as npt
 
+from ._args import number, room_for_samples
 from ._callbacks import take, raise_failure
 from ._core import RULES, STREAM_BATCH, _CHUNK, _algorithm_version
 from ._errors import _raise, created
@@ -88,12 +89,13 @@ class MeshSampler:
         desc.n_vertices = len(v)
         desc.triangles = ffi.cast("const uint32_t *", ffi.from_buffer(f))
         desc.n_triangles = len(f)
-        desc.radius = float(radius)
+        desc.radius = number("radius", radius, " (radii that vary: vertex_radii= or sizing=)")
         if vertex_radii is not None:
             vr = np.ascontiguousarray(vertex_radii, dtype=np.float64)
             if vr.shape != (len(v),):
                 raise ValueError(f"vertex_radii: shape {vr.shape}, expected ({len(v)},): one radius per vertex")
             self._keep.append(vr)
+            self._largest_radius = float(np.max(vr)) if len(vr) else desc.radius
             desc.vertex_radii = ffi.cast("const double *", ffi.from_buffer(vr))
         if sizing is not None:
             if not callable(sizing):
@@ -103,15 +105,23 @@ class MeshSampler:
             desc.sizing_batch = lib.vpds_py_sizing_batch
             desc.sizing_user = self._handle
         if lipschitz is not None:
-            desc.lipschitz = float(lipschitz)
+            desc.lipschitz = number("lipschitz", lipschitz)
+            if not desc.lipschitz >= 0:  # -1 would read as the C library's "not given"
+                raise ValueError(f"lipschitz = {lipschitz!r}: must be >= 0")
         desc.rule = RULES[rule]
-        desc.inhibition = float(inhibition)
-        desc.coverage = float(coverage)
+        desc.inhibition = number("inhibition", inhibition)
+        desc.coverage = number("coverage", coverage)
         desc.seed = _seed_from(rng)
         desc.algorithm_version = _algorithm_version(algorithm_version, _MESH_ALGORITHM_FIRST)
         self._m = created(lib.vpds_mesh_validate, lib.vpds_mesh_create, lib.vpds_mesh_destroy,
                           "vpds_mesh", desc)
         self.n_faces = len(f)
+        # the surface's area and its largest radius bound a maximal run's count from below
+        self._area = float(0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]),
+                                                axis=1).sum()) if len(f) else 0.0
+        if vertex_radii is None:
+            self._largest_radius = None if sizing is not None else desc.radius
+        self._coverage = desc.coverage
 
     def _check(self, st: int) -> int:
         cause = take(self, "_callback_error")
@@ -128,15 +138,29 @@ class MeshSampler:
         while self._check(call()) == lib.VPDS_PAUSED:
             pass
 
+    def _room(self, what: str, t: float) -> None:
+        """Refuse, before it starts, a run at scale t whose samples cannot fit in memory: every
+        point of the surface lies within t * coverage * r of one, so a maximal set holds at least
+        area / (pi (t coverage r)^2) of them (r the largest radius; a sizing callable's is not
+        known: no check)."""
+        if self._largest_radius is None or not (t > 0) or not np.isfinite(self._area):
+            return
+        reach = t * self._coverage * self._largest_radius
+        if reach > 0:
+            room_for_samples(what, self._area / (np.pi * reach * reach), 3,
+                             why=" (at least: the surface's area over pi (t coverage r)^2)")
+
     def run(self) -> "MeshSampler":
         """Sample to maximal at scale 1."""
+        self._room("run()", 1.0)
         self._drive(lambda: lib.vpds_mesh_run(self._m))
         return self
 
     def refine(self, t: float) -> "MeshSampler":
         """Add samples until maximal at the scale t (below the current one; before any run, the
         first scale)."""
-        t = float(t)
+        t = number("t", t)
+        self._room(f"refine({t})", t)
         self._drive(lambda: lib.vpds_mesh_refine(self._m, t))
         return self
 
@@ -148,6 +172,7 @@ class MeshSampler:
         at scales up to the run's; after the stream, `refine(t)` goes below its last scale."""
         if not isinstance(n, (int, np.integer)) or isinstance(n, bool) or n < 0:
             raise ValueError(f"n = {n!r}: must be an int >= 0")
+        room_for_samples(f"progressive(n={n})", n, 3)
         got = ffi.new("size_t *")
         while int(lib.vpds_mesh_count(self._m)) < n:
             # batches of vpds_mesh_next_n, so Ctrl-C stops between them
@@ -197,8 +222,9 @@ def sample_mesh(vertices: Any, faces: Any = None, *, radius: float = 0.05,
     m = MeshSampler(vertices, faces, radius=radius, sizing=sizing, vertex_radii=vertex_radii,
                     lipschitz=lipschitz, rule=rule, inhibition=inhibition, coverage=coverage, rng=rng,
                     algorithm_version=algorithm_version)
+    t = number("t", t)
     if n is not None:
-        if float(t) != 1.0:
+        if t != 1.0:
             raise ValueError(f"n = {n} with t = {t}: give one (n points from the stream, or a run at t)")
         return m.progressive(n)
     if float(t) == 1.0:

@@ -15,7 +15,9 @@ from typing import Any, Callable, Mapping, Optional, Sequence, Union
 import numpy as np
 import numpy.typing as npt
 
+from ._args import tile_counts
 from ._callbacks import raise_failure, take
+from ._optional import require
 from ._rules import RULES
 from ._errors import VpdsValueError, _raise, created
 from ._scipy_compat import _seed_from
@@ -77,11 +79,7 @@ class TilingSpec:
         d = int(d)
         if rule not in RULES:
             raise ValueError(f"rule = {rule!r}: must be one of {sorted(RULES)}")
-        tiles_t = (1,) * d if tiles is None else tuple(int(v) for v in np.atleast_1d(tiles))
-        if len(tiles_t) == 1 and d > 1:
-            tiles_t = tiles_t * d
-        if len(tiles_t) != d:
-            raise ValueError(f"tiles = {tiles!r}: need 1 or {d} counts")
+        tiles_t = (1,) * d if tiles is None else tile_counts("tiles", tiles, d)
         lo = tuple(float(v) for v in (np.zeros(d) if l_bounds is None else np.asarray(l_bounds, float).reshape(-1)))
         hi = tuple(float(v) for v in (np.ones(d) if u_bounds is None else np.asarray(u_bounds, float).reshape(-1)))
         if len(lo) != d or len(hi) != d:
@@ -123,7 +121,7 @@ class TilingSpec:
         elif isinstance(s, GridSource):
             h.update(s.token().encode())
         elif callable(s):
-            import cloudpickle
+            cloudpickle = require("cloudpickle", "workers or tiles with a sizing callable", "cloudpickle")
             h.update(cloudpickle.dumps(s))
         return h.hexdigest()[:32]
 
