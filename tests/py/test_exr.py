@@ -92,3 +92,39 @@ def test_cli_sizing_exr_smoothed_for_l(tmp_path):
     assert "smoothed for L = 0.3" in res.stdout
     z = np.load(out)
     assert z["radii"].min() >= 0.01 * (1 - 1e-12) and z["radii"].max() <= 0.05 * (1 + 1e-12)
+
+
+def cli(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "vpds", "sample", *args, "--no-progress"],
+                          capture_output=True, text=True, cwd=cwd)
+
+
+def test_rgb_images_give_their_components_as_channels(tmp_path):
+    """OpenEXR's Python API reads R, G, B (A) as one grouped channel 'RGB' ('RGBA'): R, G, B
+    and A are still the channels a user names, and R is the default after Y."""
+    from vpds.exr import read_channel
+    ones = np.ones((6, 8), np.float32)
+    rgb = tmp_path / "rgb.exr"
+    write_exr(rgb, {"R": 0.02 * ones, "G": 0.03 * ones, "B": 0.04 * ones})
+    rgba = tmp_path / "rgba.exr"
+    write_exr(rgba, {"RGBA": np.stack([0.02 * ones, 0.03 * ones, 0.04 * ones, 0.05 * ones], axis=-1)})
+    for path in (rgb, rgba):
+        assert np.all(read_channel(path) == np.float32(0.02))
+        assert np.all(read_channel(path, "G") == np.float32(0.03))
+        assert np.all(read_channel(path, "B") == np.float32(0.04))
+    assert np.all(read_channel(rgba, "A") == np.float32(0.05))
+    with pytest.raises(ValueError, match=r"no channel 'A'; it has \['B', 'G', 'R'\]"):
+        read_channel(rgb, "A")
+    for channel, r in ((None, 0.02), ("B", 0.04)):
+        out = tmp_path / f"{channel}.npz"
+        res = cli("--sizing-exr", str(rgb), *(["--channel", channel] if channel else []),
+                  "-o", str(out))
+        assert res.returncode == 0, res.stderr
+        np.testing.assert_allclose(np.load(out)["radii"], np.float32(r))
+
+
+def test_a_corrupt_file_is_a_value_error_naming_it(tmp_path):
+    bad = tmp_path / "bad.exr"
+    bad.write_bytes(b"not an exr")
+    with pytest.raises(ValueError, match="bad.exr: not a readable OpenEXR file"):
+        vpds.PoissonDisk(2, sizing=bad)

@@ -19,28 +19,54 @@ if TYPE_CHECKING:  # for the annotation: sizing_grid_from_exr imports it itself,
     from .sizing_grid import SizingGrid
 
 
-def read_channel(path: Union[str, PathLike[str]], channel: Optional[str] = None) -> npt.NDArray[np.float64]:
-    """One channel as float64, shape (rows, columns); half and float channels alike."""
+def _channels(path: Union[str, PathLike[str]]) -> dict[str, npt.NDArray[np.float64]]:
+    """Every channel of the file by name, each (rows, columns). OpenEXR's Python API groups R, G,
+    B (and A) into one channel 'RGB' or 'RGBA' of shape (rows, columns, 3 or 4), and a layer's
+    into 'layer'; they are split here into R, G, B, A (and layer.R, ...) as the file names them.
+    A file OpenEXR cannot open is a ValueError naming it."""
     try:
         import OpenEXR
     except ImportError as exc:
         raise ImportError("reading .exr sizing images needs the OpenEXR package "
                           "(pip install OpenEXR)") from exc
-    with OpenEXR.File(str(path)) as f:
-        channels = f.channels()
-        names = sorted(channels)
-        if channel is None:
-            for guess in ("Y", "R", "L"):
-                if guess in channels:
-                    channel = guess
-                    break
-            else:
-                if len(names) != 1:
-                    raise ValueError(f"{path}: channels {names}: choose one (channel=...)")
-                channel = names[0]
-        if channel not in channels:
-            raise ValueError(f"{path}: no channel {channel!r}; it has {names}")
-        pixels = np.asarray(channels[channel].pixels, dtype=np.float64)
+    try:
+        try:
+            f = OpenEXR.File(str(path), separate_channels=True)
+        except TypeError:  # OpenEXR before 3.3: grouped channels only, split below
+            f = OpenEXR.File(str(path))
+        with f:
+            grouped = {name: np.asarray(c.pixels, dtype=np.float64) for name, c in f.channels().items()}
+    except RuntimeError as exc:  # OpenEXR's "Unable to open ..." for a missing or corrupt file
+        raise ValueError(f"{path}: not a readable OpenEXR file ({exc})") from None
+    channels: dict[str, npt.NDArray[np.float64]] = {}
+    for name, pixels in grouped.items():
+        if pixels.ndim == 3 and 1 <= pixels.shape[2] <= 4:
+            letters = name if name in ("RGB", "RGBA") else "RGBA"[:pixels.shape[2]]
+            prefix = "" if name in ("RGB", "RGBA") else f"{name}."
+            for k, letter in enumerate(letters[:pixels.shape[2]]):
+                channels[prefix + letter] = pixels[:, :, k]
+        else:
+            channels[name] = pixels
+    return channels
+
+
+def read_channel(path: Union[str, PathLike[str]], channel: Optional[str] = None) -> npt.NDArray[np.float64]:
+    """One channel as float64, shape (rows, columns); half and float channels alike. The
+    default: Y, else R (of an RGB or RGBA image too), else L, else the only channel."""
+    channels = _channels(path)
+    names = sorted(channels)
+    if channel is None:
+        for guess in ("Y", "R", "L"):
+            if guess in channels:
+                channel = guess
+                break
+        else:
+            if len(names) != 1:
+                raise ValueError(f"{path}: channels {names}: choose one (channel=...)")
+            channel = names[0]
+    if channel not in channels:
+        raise ValueError(f"{path}: no channel {channel!r}; it has {names}")
+    pixels = channels[channel]
     if pixels.ndim != 2:
         raise ValueError(f"{path}: channel {channel!r} has shape {pixels.shape}; expected 2D pixels")
     return pixels
