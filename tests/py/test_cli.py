@@ -276,3 +276,27 @@ def test_sample_and_help_without_scipy_or_matplotlib(tmp_path):
     assert "Traceback" not in res.stderr
     res = run("analyze", "a.npz")
     assert res.returncode == 2 and "pip install scipy" in res.stderr and "Traceback" not in res.stderr
+
+
+# -- bad input: one line naming the option and the value, status 2, no traceback -------------------
+
+def assert_usage_error(res, *names):
+    """Status 2, one line on stderr naming each of `names`, no traceback."""
+    assert res.returncode == 2, res.stdout + res.stderr
+    assert "Traceback" not in res.stderr, res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1, res.stderr
+    for name in names:
+        assert name in res.stderr, (name, res.stderr)
+
+
+def run_in(tmp_path, *args, env=None):
+    return subprocess.run([sys.executable, "-m", "vpds", *args], capture_output=True, text=True,
+                          cwd=tmp_path, env=env)
+
+
+def test_an_unwritable_output_directory_is_refused_before_sampling(tmp_path):
+    if not os.path.isdir("/proc"):
+        pytest.skip("needs /proc, where no file can be created even by root")
+    res = run_in(tmp_path, "sample", "-o", "/proc/a.npz", "--no-progress")
+    assert_usage_error(res, "-o /proc/a.npz", "not writable")
+    assert res.stdout == ""

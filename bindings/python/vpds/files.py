@@ -17,7 +17,7 @@ from typing import Any, BinaryIO, Callable, Mapping, Optional, cast
 import numpy as np
 import numpy.typing as npt
 
-from .cli_common import UsageError
+from .cli_common import UsageError, check_directory
 
 __all__ = ["Record", "OUTPUT_SUFFIXES", "check_output", "write_points", "read_points"]
 
@@ -37,18 +37,15 @@ class Record:
 
 
 def check_output(path: Path, dim: int) -> None:
-    """Refuse an output path before sampling: a suffix we cannot write, a missing directory."""
+    """Refuse an output path before sampling: a suffix we cannot write, a directory that is
+    missing or where no file can be created."""
     suffix = path.suffix.lower()
     if suffix not in OUTPUT_SUFFIXES:
         raise UsageError(f"-o {path}: unsupported extension {suffix or '(none)'!r}; use "
                          f"{', '.join(OUTPUT_SUFFIXES)} (or .zarr with --tiles)")
     if suffix == ".ply" and dim > 3:
         raise UsageError(f"-o {path}: .ply holds up to 3 coordinates, --dim is {dim}")
-    parent = path.parent if str(path.parent) else Path(".")
-    if not parent.is_dir():
-        raise UsageError(f"-o {path}: directory {parent} does not exist")
-    if not os.access(parent, os.W_OK):
-        raise UsageError(f"-o {path}: directory {parent} is not writable")
+    check_directory(path, "-o")
 
 
 def _atomic(path: Path, write: Callable[[BinaryIO], None]) -> None:
