@@ -300,3 +300,33 @@ def test_an_unwritable_output_directory_is_refused_before_sampling(tmp_path):
     res = run_in(tmp_path, "sample", "-o", "/proc/a.npz", "--no-progress")
     assert_usage_error(res, "-o /proc/a.npz", "not writable")
     assert res.stdout == ""
+
+
+@pytest.fixture(scope="module")
+def sampled(tmp_path_factory):
+    out = tmp_path_factory.mktemp("analyze") / "good.npz"
+    vpds("sample", "--radius", "0.1", "--seed", "1", "-o", str(out), "--no-progress")
+    return out
+
+
+@pytest.mark.parametrize("flag, value", [("--coverage", "0"), ("--inhibition", "-1"),
+                                         ("--lipschitz", "-1"), ("--radius", "-1"),
+                                         ("--scale", "-1"), ("--scale", "nan"),
+                                         ("--coverage", "inf")])
+def test_analyze_refuses_a_flag_that_cannot_hold(sampled, flag, value):
+    res = vpds("analyze", str(sampled), flag, value, check=False)
+    assert_usage_error(res, f"{flag} {value}", "must be finite")
+    assert res.stdout == ""  # no verdict
+
+
+def test_analyze_refuses_points_it_cannot_check(tmp_path):
+    np.save(tmp_path / "empty.npy", np.zeros((0, 2)))
+    np.save(tmp_path / "nan.npy", np.full((5, 2), np.nan))
+    res = run_in(tmp_path, "analyze", "empty.npy", "--radius", "0.05")
+    assert_usage_error(res, "empty.npy", "no points")
+    res = run_in(tmp_path, "analyze", "nan.npy", "--radius", "0.05")
+    assert_usage_error(res, "nan.npy", "5 of 5 points", "non-finite")
+    (tmp_path / "bad.csv").write_text("x0,x1\n0.1,0.2\n0.5,0.5\n")
+    res = run_in(tmp_path, "analyze", "bad.csv")
+    assert_usage_error(res, "bad.csv", "no column r", "--radius")
+    assert ".npy" not in res.stderr

@@ -18,7 +18,7 @@ import numpy.typing as npt
 
 from ._core import RULES
 from ._optional import require
-from .cli_common import UsageError, domain_from_file, floats_arg, sizing_from_expression
+from .cli_common import UsageError, check_plot, domain_from_file, floats_arg, number_arg, sizing_from_expression
 from .files import Record, read_points
 
 if TYPE_CHECKING:  # for the annotations: vpds.analysis needs scipy, imported when run
@@ -57,12 +57,12 @@ def _sizing(args: argparse.Namespace, rec: Record, meta: dict[str, Any], dim: in
             lo: npt.NDArray[np.float64], hi: npt.NDArray[np.float64], analysis: ModuleType
             ) -> tuple[Optional[Sizing], str]:
     """The sizing r(x) and L to check against, and where they came from."""
-    expr = args.sizing or (meta.get("sizing") if args.radius is None else None)
-    if expr:
+    expr = args.sizing if args.sizing is not None else (meta.get("sizing") if args.radius is None else None)
+    if expr is not None:
         lip = args.lipschitz if args.lipschitz is not None else meta.get("lipschitz")
         if lip is None:
             raise UsageError(f"--sizing {expr!r} needs --lipschitz (the file does not record it)")
-        src = "--sizing" if args.sizing else "the file"
+        src = "--sizing" if args.sizing is not None else "the file"
         return analysis.Sizing(sizing_from_expression(expr, dim), float(lip)), f"r = {expr} ({src})"
     if args.radius is not None:
         return analysis.sizing_named("const", args.radius), f"radius {args.radius} (--radius)"
@@ -96,8 +96,17 @@ def _params(args: argparse.Namespace, rec: Record, analysis: ModuleType) -> Para
     rule = pick(args.rule, "rule", "smaller")
     if rule not in RULES:
         raise UsageError(f"{args.file}: recorded rule {rule!r} is not one of {sorted(RULES)}")
-    return Params(dim, lo, hi, rule, float(pick(args.inhibition, "inhibition", 1.0)),
-                  float(pick(args.coverage, "coverage", 1.0)), meta.get("periodic"), scale,
+    factors = {}
+    for key in ("inhibition", "coverage"):  # a flag is checked in cmd_analyze; this is the file's
+        value = float(pick(getattr(args, key), key, 1.0))
+        if not (math.isfinite(value) and value > 0):
+            raise UsageError(f"{args.file}: recorded {key} {value!r} is not finite and > 0 "
+                             f"(give --{key})")
+        factors[key] = value
+    if not (math.isfinite(scale) and scale > 0):
+        raise UsageError(f"{args.file}: its smallest scale t = {scale!r} is not > 0 (give --scale)")
+    return Params(dim, lo, hi, rule, factors["inhibition"],
+                  factors["coverage"], meta.get("periodic"), scale,
                   float(meta.get("stream_tolerance", 0.0)), str(meta.get("mode", "unknown")),
                   sizing, note, meta.get("domain"), float(meta.get("domain_threshold") or 0.5))
 
@@ -181,16 +190,54 @@ def _table1(rec: Record, p: Params, analysis: ModuleType) -> Optional[Check]:
                  f"{rep.edge_max_ratio:.3f}] (bounds [{emin:.3f}, {emax:.3f}])")
 
 
+def _check_flags(args: argparse.Namespace) -> None:
+    """The numeric flags: each a usage error naming it when it cannot mean what it says."""
+    if args.sizing is not None and not args.sizing.strip():
+        raise UsageError(f"--sizing {args.sizing!r}: empty; give r(x) as an expression in x")
+    number_arg(args.radius, "--radius")
+    number_arg(args.lipschitz, "--lipschitz", strict=False)
+    number_arg(args.inhibition, "--inhibition")
+    number_arg(args.coverage, "--coverage")
+    number_arg(args.scale, "--scale")
+
+
+# why a file has no radii, by its format
+_NO_RADII = {".npy": "a .npy holds points only", ".csv": "no column r",
+             ".npz": "no array 'radii'", ".ply": "no radius property"}
+
+
+def _check_points(rec: Record, path: Path) -> None:
+    """Points (and radii) the checks can use: at least one, all finite (radii > 0)."""
+    n = len(rec.points)
+    if n == 0:
+        raise UsageError(f"{path}: no points in it: nothing to analyze")
+    bad = int(np.count_nonzero(~np.all(np.isfinite(rec.points), axis=1)))
+    if bad:
+        raise UsageError(f"{path}: {bad} of {n} points have a non-finite coordinate (NaN or inf)")
+    if rec.radii is not None:
+        r = np.asarray(rec.radii, dtype=np.float64)
+        bad = int(np.count_nonzero(~(np.isfinite(r) & (r > 0))))
+        if bad:
+            raise UsageError(f"{path}: {bad} of {n} radii are not finite and > 0")
+
+
 def cmd_analyze(args: argparse.Namespace) -> int:
     analysis = require("vpds.analysis", "vpds analyze", "scipy")
-    rec = read_points(Path(args.file))
+    _check_flags(args)
+    if args.plot:
+        check_plot(Path(args.plot))  # before the analysis, not after
+    path = Path(args.file)
+    rec = read_points(path)
+    _check_points(rec, path)
     if rec.radii is None:
         if args.radius is None and args.sizing is None:
-            raise UsageError(f"{args.file}: the file has no radii (a .npy holds points only): "
+            why = _NO_RADII.get(path.suffix.lower(), "none recorded")
+            raise UsageError(f"{args.file}: the file has no radii ({why}): "
                              "give --radius or --sizing with --lipschitz")
-        fn = (sizing_from_expression(args.sizing, rec.points.shape[1]) if args.sizing
+        fn = (sizing_from_expression(args.sizing, rec.points.shape[1]) if args.sizing is not None
               else (lambda y: np.full(len(y), args.radius)))
         rec.radii = fn(rec.points)
+        _check_points(rec, path)
     p = _params(args, rec, analysis)
     n = len(rec.points)
     print(f"{n} points in {p.dim}D, rule {p.rule}, {p.sizing_note}, scale t = {p.scale:g}, "
@@ -213,8 +260,11 @@ def cmd_analyze(args: argparse.Namespace) -> int:
         if t1 is not None and t1.status != "not checked":
             report = analysis.check_delaunay(rec.points, rec.radii, p.rule, 0.0, p.lo, p.hi)
         lip = p.sizing.lipschitz if p.sizing is not None else 0.0
-        plot_analysis(Path(args.plot), rec.points, rec.radii, p.lo, p.hi, report, p.rule,
-                      p.scale * lip, p.scale)
+        try:
+            plot_analysis(Path(args.plot), rec.points, rec.radii, p.lo, p.hi, report, p.rule,
+                          p.scale * lip, p.scale)
+        except OSError as exc:
+            raise UsageError(f"--plot {args.plot}: cannot write it: {exc.strerror or exc}") from None
         print(f"wrote {args.plot}")
     return _verdict(checks)
 
@@ -249,5 +299,6 @@ def add_analyze_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser],
     a.add_argument("--hi", help="upper corner (default: the file's, else 1)")
     a.add_argument("--scale", type=float, help="the scale t to check at (default: the file's "
                    "smallest finite t, else 1)")
-    a.add_argument("--plot", help="write the analysis PNG (needs matplotlib)")
+    a.add_argument("--plot", help="write the analysis picture: .png, .pdf, .svg, ... (the "
+                   "formats matplotlib writes; needs matplotlib)")
     a.set_defaults(func=cmd_analyze)
