@@ -294,12 +294,137 @@ def run_in(tmp_path, *args, env=None):
                           cwd=tmp_path, env=env)
 
 
+@pytest.mark.parametrize("args, names", [
+    (["--refine", "abc"], ["--refine 'abc'", "expected scales"]),
+    (["--refine", "0.5,,0.4"], ["--refine '0.5,,0.4'"]),
+    (["--refine", "-1"], ["--refine '-1'", "scale -1"]),
+    (["--refine", "0.5,0.8"], ["--refine '0.5,0.8'", "above the one before"]),
+    (["--sizing", "", "--lipschitz", "0.1"], ["--sizing ''", "empty"]),
+    (["--stream", "10", "--refine", "0.5"], ["--stream with --refine"]),
+    (["--stream", "-1"], ["--stream -1"]),
+    (["--channel", "R"], ["--channel R", "without --sizing-exr"]),
+    (["--exr-range", "0.01,0.05"], ["--exr-range 0.01,0.05", "without --sizing-exr"]),
+    (["--workers", "2"], ["--workers 2", "without --tiles"]),
+    (["--radius-max", "0.1"], ["--radius-max 0.1", "without --threads or --tiles"]),
+    (["--lipschitz", "-1", "--sizing", "0.05 + 0*x[0]"], ["--lipschitz -1", ">= 0"]),
+    (["--tiles", "-1", "-o", "t.zarr"], ["--tiles '-1'", ">= 1"]),
+    (["--tiles", "2,0", "-o", "t.zarr"], ["--tiles '2,0'", ">= 1"]),
+    (["--tiles", "100000", "-o", "t.zarr"], ["--tiles '100000'", "use fewer"]),
+    (["--tiles", "2", "--periodic", "x", "-o", "t.zarr"], ["--periodic 'x'"]),
+    (["--sizing", "0.01 + x[5]", "--lipschitz", "0.1", "--lo", "0,2", "--hi", "1,4"],
+     ["--sizing", "the box centre, x = (0.5, 3)"]),
+])
+def test_option_values_are_named_when_refused(tmp_path, args, names):
+    res = run_in(tmp_path, "sample", *args, "--no-progress")
+    assert_usage_error(res, *names)
+    assert "samples in" not in res.stdout and not list(tmp_path.iterdir())
+
+
+def test_dim_help_says_what_the_library_accepts():
+    from vpds import MAX_DIM
+    text = " ".join(vpds("sample", "--help").stdout.split())
+    assert f"dimension, 1 to {MAX_DIM}" in text
+
+
+def test_stream_0_gives_an_empty_sampling(tmp_path):
+    res = run_in(tmp_path, "sample", "--stream", "0", "-o", "s.npz", "--no-progress")
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.startswith("0 samples in 2D")
+    z = np.load(tmp_path / "s.npz")
+    assert z["points"].shape == (0, 2)
+    res = run_in(tmp_path, "analyze", "s.npz")
+    assert_usage_error(res, "s.npz", "no points")
+
+
+@pytest.mark.parametrize("name, content, names", [
+    ("bad.wkt", "POLYGON((0 0, 1 0", ["--domain bad.wkt", "not a WKT polygon"]),
+    ("empty.wkt", "", ["--domain empty.wkt", "not a WKT polygon"]),
+    ("point.wkt", "POINT (0.5 0.5)", ["--domain point.wkt", "not a polygon"]),
+    ("garbage.png", "garbage", ["--domain garbage.png", "cannot read it as an image"]),
+    ("empty.png", "", ["--domain empty.png", "cannot read it as an image"]),
+    ("foo.xyz", "x", ["--domain foo.xyz", ".xyz: not an image"]),
+])
+def test_a_domain_file_that_cannot_be_read_names_domain(tmp_path, name, content, names):
+    if name.endswith(".wkt"):
+        pytest.importorskip("shapely")
+    else:
+        pytest.importorskip("PIL")
+    (tmp_path / name).write_text(content)
+    res = run_in(tmp_path, "sample", "--domain", name, "--no-progress")
+    assert_usage_error(res, *names)
+
+
+def test_a_domain_mask_of_the_wrong_dimension_names_domain(tmp_path):
+    np.save(tmp_path / "mask.npy", np.ones((4, 4, 4), bool))
+    res = run_in(tmp_path, "sample", "--domain", "mask.npy", "--no-progress")
+    assert_usage_error(res, "--domain mask.npy", "d = 2")
+
+
+def test_a_corrupt_exr_names_sizing_exr(tmp_path):
+    pytest.importorskip("OpenEXR")
+    (tmp_path / "garbage.exr").write_text("garbage")
+    res = run_in(tmp_path, "sample", "--sizing-exr", "garbage.exr", "--no-progress")
+    assert_usage_error(res, "--sizing-exr garbage.exr", "not a readable OpenEXR file")
+
+
+@pytest.mark.parametrize("where", ["sample", "analyze", "mesh"])
+@pytest.mark.parametrize("plot, message", [("/nonexistent/x.png", "directory /nonexistent does not exist"),
+                                           ("foo.txt", "unsupported extension '.txt'"),
+                                           ("foo", "unsupported extension '(none)'")])
+def test_a_plot_path_is_checked_before_sampling(tmp_path, where, plot, message):
+    pytest.importorskip("matplotlib")
+    if where == "analyze":
+        np.save(tmp_path / "p.npy", np.random.default_rng(0).random((20, 2)))
+        args = ["analyze", "p.npy", "--radius", "0.1"]
+    elif where == "mesh":
+        pytest.importorskip("trimesh")
+        (tmp_path / "tet.obj").write_text(TETRAHEDRON)
+        args = ["sample", "--mesh", "tet.obj", "--no-progress"]
+    else:
+        args = ["sample", "--no-progress"]
+    res = run_in(tmp_path, *args, "--plot", plot)
+    assert_usage_error(res, f"--plot {plot}", message)
+    assert res.stdout == ""  # refused before any sampling or analysis
+
+
 def test_an_unwritable_output_directory_is_refused_before_sampling(tmp_path):
     if not os.path.isdir("/proc"):
         pytest.skip("needs /proc, where no file can be created even by root")
     res = run_in(tmp_path, "sample", "-o", "/proc/a.npz", "--no-progress")
     assert_usage_error(res, "-o /proc/a.npz", "not writable")
     assert res.stdout == ""
+
+
+def test_a_failed_write_is_one_line(tmp_path):
+    """An OSError while writing (here: the target is a directory) is one line, no traceback,
+    and leaves no temporary file behind."""
+    (tmp_path / "out.npz").mkdir()
+    res = run_in(tmp_path, "sample", "--radius", "0.1", "-o", "out.npz", "--no-progress")
+    assert_usage_error(res, "-o out.npz", "cannot write it")
+    assert "samples in" in res.stdout
+    assert [p.name for p in tmp_path.iterdir()] == ["out.npz"]
+
+
+def blocking(tmp_path, *modules):
+    """An environment in which importing `modules` fails, as when they are not installed."""
+    (tmp_path / "sitecustomize.py").write_text(
+        "import sys\n"
+        "class Block:\n"
+        "    def find_spec(self, name, path=None, target=None):\n"
+        f"        if name.split('.')[0] in {modules!r}:\n"
+        "            raise ImportError(f'blocked: {name}')\n"
+        "sys.meta_path.insert(0, Block())\n")
+    return dict(os.environ, PYTHONPATH=str(tmp_path))
+
+
+def test_missing_tiling_dependencies_are_one_line_naming_the_install(tmp_path):
+    env = blocking(tmp_path, "zarr", "distributed", "dask", "cloudpickle")
+    res = run_in(tmp_path, "sample", "--tiles", "2", "-o", "t.zarr", "--no-progress", env=env)
+    assert_usage_error(res, "--tiles", "pip install", "zarr")
+    res = run_in(tmp_path, "sample", "--threads", "2", "--sizing", "0.05+0*x[0]", "--lipschitz",
+                 "0.1", "--radius-max", "0.05", "--no-progress", env=env)
+    assert_usage_error(res, "--threads", "pip install cloudpickle")
+    assert not (tmp_path / "t.zarr").exists()
 
 
 @pytest.fixture(scope="module")
@@ -330,3 +455,23 @@ def test_analyze_refuses_points_it_cannot_check(tmp_path):
     res = run_in(tmp_path, "analyze", "bad.csv")
     assert_usage_error(res, "bad.csv", "no column r", "--radius")
     assert ".npy" not in res.stderr
+
+
+TETRAHEDRON = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+
+
+@pytest.mark.parametrize("args, names", [
+    (["--refine", "abc"], ["--refine 'abc'"]),
+    (["--refine", "0.5,,0.4"], ["--refine '0.5,,0.4'"]),
+    (["--refine", "-1"], ["--refine '-1'"]),
+    (["--threads", "2"], ["--threads", "not available with --mesh"]),
+    (["--sizing", "", "--lipschitz", "0.1"], ["--sizing ''", "empty"]),
+    (["--sizing", "0.1 + x[3]", "--lipschitz", "0.1"],
+     ["--sizing", "the centre of the mesh's bounding box, x = 0.5 (3 coordinates"]),
+])
+def test_mesh_option_mistakes_name_the_option(tmp_path, args, names):
+    pytest.importorskip("trimesh")
+    (tmp_path / "tet.obj").write_text(TETRAHEDRON)
+    res = run_in(tmp_path, "sample", "--mesh", "tet.obj", *args, "--no-progress")
+    assert_usage_error(res, *names)
+    assert "box centre" not in res.stderr

@@ -123,8 +123,27 @@ def test_rgb_images_give_their_components_as_channels(tmp_path):
         np.testing.assert_allclose(np.load(out)["radii"], np.float32(r))
 
 
+def test_cli_unknown_channel_names_channel_and_the_components(tmp_path):
+    ones = np.ones((6, 8), np.float32)
+    rgb = tmp_path / "rgb.exr"
+    write_exr(rgb, {"R": 0.02 * ones, "G": 0.03 * ones, "B": 0.04 * ones})
+    res = cli("--sizing-exr", str(rgb), "--channel", "Q")
+    assert res.returncode == 2 and "Traceback" not in res.stderr
+    assert "--channel Q" in res.stderr and "['B', 'G', 'R']" in res.stderr
+
+
 def test_a_corrupt_file_is_a_value_error_naming_it(tmp_path):
     bad = tmp_path / "bad.exr"
     bad.write_bytes(b"not an exr")
     with pytest.raises(ValueError, match="bad.exr: not a readable OpenEXR file"):
         vpds.PoissonDisk(2, sizing=bad)
+
+
+@pytest.mark.parametrize("value", ["0.01", "a,b", "0.01,0.02,0.03", "0.05,0.01", "0,0.1"])
+def test_cli_exr_range_needs_lo_hi(tmp_path, value):
+    path = tmp_path / "y.exr"
+    write_exr(path, {"Y": np.full((4, 4), 0.5, np.float32)})
+    res = cli("--sizing-exr", str(path), "--exr-range", value)
+    assert res.returncode == 2 and "Traceback" not in res.stderr, res.stderr
+    assert f"--exr-range {value!r}" in res.stderr and "LO" in res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1

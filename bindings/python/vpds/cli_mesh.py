@@ -12,12 +12,12 @@ from pathlib import Path
 import numpy as np
 
 from ._optional import require
-from .cli_common import UsageError, sizing_from_expression
+from .cli_common import UsageError, check_plot, number_arg, scales_arg, sizing_from_expression
 from .files import check_output, write_points
 
 # box-only options and the defaults that mean "not given"
 _BOX_ONLY = {"periodic": None, "domain": None, "sizing_exr": None, "lo": None, "hi": None,
-             "tiles": None}
+             "tiles": None, "threads": None}
 
 
 def add_mesh_arguments(s: argparse.ArgumentParser) -> None:
@@ -49,21 +49,26 @@ def cmd_sample_mesh(args: argparse.Namespace) -> int:
         raise UsageError("--dim is not available with --mesh (a surface in 3D)")
     if args.stream is not None and args.stream < 0:
         raise UsageError(f"--stream {args.stream}: must be >= 0")
-    if args.stream and args.refine:
+    if args.stream is not None and args.refine is not None:
         raise UsageError("--stream with --refine: the stream gives the points and their scales; "
                          "use one or the other")
     if args.output:
         check_output(Path(args.output), 3)
     if args.plot:
-        require("matplotlib", "--plot", "matplotlib")
+        check_plot(Path(args.plot))  # before sampling, not after
+    refine = scales_arg(args.refine)
+    number_arg(args.lipschitz, "--lipschitz", strict=False)
     vertices, faces = _load(Path(args.mesh))
-    refine = [float(v) for v in args.refine.split(",")] if args.refine else []
-    sizing = sizing_from_expression(args.sizing, 3) if args.sizing else None
+    sizing = None
+    if args.sizing is not None:  # probed at the centre of the mesh's bounding box
+        centre = (vertices.min(axis=0) + vertices.max(axis=0)) / 2
+        sizing = sizing_from_expression(args.sizing, 3, at=centre,
+                                        where="the centre of the mesh's bounding box")
     sampler = MeshSampler(vertices, faces, radius=args.radius, sizing=sizing, lipschitz=args.lipschitz,
                           rule=args.rule, inhibition=args.inhibition, coverage=args.coverage,
                           rng=args.seed)
     t0 = time.perf_counter()
-    if args.stream:
+    if args.stream is not None:
         sampler.progressive(args.stream)  # exactly N points, each prefix maximal at its scale
     else:
         sampler.run()
@@ -71,24 +76,31 @@ def cmd_sample_mesh(args: argparse.Namespace) -> int:
             sampler.refine(t)
     seconds = time.perf_counter() - t0
     s = sampler.samples
-    what = f"r = {args.sizing}" if args.sizing else f"radius {args.radius}"
+    what = f"r = {args.sizing}" if args.sizing is not None else f"radius {args.radius}"
     print(f"{len(s.points)} samples on {args.mesh} ({len(faces)} triangles; {what}, rule {args.rule}, "
           f"seed {args.seed}) in {seconds:.3f} s; maximal: {s.maximal}")
     if args.output:
         from . import STREAM_TOLERANCE
         meta = dict(mesh=str(args.mesh), rule=args.rule, seed=args.seed, coverage=args.coverage,
                     inhibition=args.inhibition, refine=refine, complete=True,
-                    mode="stream" if args.stream else "refine" if refine else "run",
-                    **({"stream_tolerance": STREAM_TOLERANCE} if args.stream else {}),
-                    **({"sizing": args.sizing, "lipschitz": args.lipschitz} if args.sizing
+                    mode="stream" if args.stream is not None else "refine" if refine else "run",
+                    **({"stream_tolerance": STREAM_TOLERANCE} if args.stream is not None else {}),
+                    **({"sizing": args.sizing, "lipschitz": args.lipschitz} if args.sizing is not None
                        else {"radius": args.radius}))
-        write_points(Path(args.output), s.points, s.radii, s.scales, np.zeros(len(s.points), bool), meta,
-                     columns={"face": s.faces, "b0": s.barycentrics[:, 0], "b1": s.barycentrics[:, 1],
-                              "b2": s.barycentrics[:, 2]})
+        try:
+            write_points(Path(args.output), s.points, s.radii, s.scales, np.zeros(len(s.points), bool),
+                         meta, columns={"face": s.faces, "b0": s.barycentrics[:, 0],
+                                        "b1": s.barycentrics[:, 1], "b2": s.barycentrics[:, 2]})
+        except OSError as exc:
+            raise UsageError(f"-o {args.output}: cannot write it: {exc.strerror or exc}") from None
         print(f"wrote {args.output}")
     if args.plot:
         from .plots import plot_mesh
-        plot_mesh(Path(args.plot), vertices, faces, s.points,
-                  f"{len(s.points)} samples on {Path(args.mesh).name}, {what}, rule {args.rule}", radii=s.radii)
+        try:
+            plot_mesh(Path(args.plot), vertices, faces, s.points,
+                      f"{len(s.points)} samples on {Path(args.mesh).name}, {what}, rule {args.rule}",
+                      radii=s.radii)
+        except OSError as exc:
+            raise UsageError(f"--plot {args.plot}: cannot write it: {exc.strerror or exc}") from None
         print(f"wrote {args.plot}")
     return 0

@@ -3,13 +3,19 @@ tiles (vpds.distributed). The other options of `vpds sample` keep their meaning.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
+from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Optional
 
 import numpy as np
 
-from .cli_common import UsageError
+from ._optional import require
+from .cli_common import UsageError, check_directory, check_unused_options, exr_range_arg, number_arg, periodic_arg
+
+# more tiles than this is a mistake (each tile is a group in the store and a task on Dask)
+MAX_TILES = 10**9
 
 if TYPE_CHECKING:  # for the annotation: vpds.tiling loads the C extension
     from .tiling import SizingArg
@@ -29,46 +35,74 @@ def add_tile_arguments(s: argparse.ArgumentParser, plain: Callable[[argparse.Nam
     s.set_defaults(func=lambda args: cmd_sample_tiles(args) if args.tiles else plain(args))
 
 
+def _tile_counts(text: str, dim: int) -> Optional[list[int]]:
+    """--tiles: 'auto' (None), or one count for every axis, or `dim` counts, each >= 1."""
+    if text == "auto":
+        return None
+    try:
+        counts = [int(v) for v in text.split(",")]
+    except ValueError:
+        raise UsageError(f"--tiles {text!r}: expected tile counts separated by commas, "
+                         "or auto") from None
+    if len(counts) == 1:
+        counts = counts * dim
+    if len(counts) != dim:
+        raise UsageError(f"--tiles has {len(counts)} counts for --dim {dim}")
+    bad = [c for c in counts if c < 1]
+    if bad:
+        raise UsageError(f"--tiles {text!r}: a tile count must be >= 1 (got {bad[0]})")
+    total = math.prod(counts)
+    if total > MAX_TILES:
+        raise UsageError(f"--tiles {text!r}: {total:.3g} tiles in all, more than {MAX_TILES:.0e}; "
+                         "use fewer (or auto)")
+    return counts
+
+
 def cmd_sample_tiles(args: argparse.Namespace) -> int:
-    from . import distributed
     from .cli_common import floats_arg as _floats, sizing_from_expression
+    check_unused_options(args)
     dim = args.dim
+    if args.mesh is not None:
+        raise UsageError("--tiles is not available with --mesh")
     if not args.output or not args.output.rstrip("/").endswith(".zarr"):
         raise UsageError("--tiles writes a Zarr store: give -o NAME.zarr")
+    check_directory(Path(args.output.rstrip("/")), "-o")
     for flag in ("refine", "stream", "plot", "threads"):
-        if getattr(args, flag):
+        if getattr(args, flag) is not None:
             raise UsageError(f"--{flag} is not available with --tiles (--tiles runs the tiles on "
                              "Dask, --workers processes; --threads runs them in this process)")
-    counts: Optional[list[int]] = None
-    if args.tiles != "auto":
-        try:
-            counts = [int(v) for v in args.tiles.split(",")]
-        except ValueError:
-            raise UsageError(f"--tiles {args.tiles!r}: expected tile counts separated by commas, "
-                             "or auto") from None
-        if len(counts) == 1:
-            counts = counts * dim
-        if len(counts) != dim:
-            raise UsageError(f"--tiles has {len(counts)} counts for --dim {dim}")
+    counts = _tile_counts(args.tiles, dim)
     lo = _floats(args.lo, dim, 0.0, "--lo")
     hi = _floats(args.hi, dim, 1.0, "--hi")
+    number_arg(args.lipschitz, "--lipschitz", strict=False)
+    number_arg(args.radius_max, "--radius-max")
+    if args.workers is not None and args.workers < 1:
+        raise UsageError(f"--workers {args.workers}: must be >= 1")
     sizing: SizingArg = None
-    if args.sizing:
+    if args.sizing is not None:
         if args.radius_max is None:
             raise UsageError("--sizing with --tiles needs --radius-max (an upper bound "
                              "of r: it sets the margin the tiles share)")
-        sizing = sizing_from_expression(args.sizing, dim)
-    elif args.sizing_exr:
+        sizing = sizing_from_expression(args.sizing, dim, at=(lo + hi) / 2)
+    elif args.sizing_exr is not None:
         if args.lipschitz is not None:
             raise UsageError("--lipschitz smooths an image in memory; with --tiles the "
                              "image is read per tile: smooth it first, or run without --tiles")
-        exr_range = [float(v) for v in args.exr_range.split(",")] if args.exr_range else None
-        sizing = distributed.GridSource(args.sizing_exr, lo, hi, channel=args.channel,
-                                        radius_range=exr_range)
-    periodic = None
-    if args.periodic:
-        axes = {int(a) for a in args.periodic.split(",")} if args.periodic != "all" else set(range(dim))
-        periodic = [k in axes for k in range(dim)]
+        exr_range = exr_range_arg(args.exr_range)
+    periodic = periodic_arg(args.periodic, dim)
+    # what the tiled run imports, asked for before any work: one line naming the pip install
+    install = '"dask[distributed]" zarr'
+    require("zarr", "--tiles", install)
+    require("distributed", "--tiles", install)
+    if args.sizing is not None:  # the tiling hashes the sizing function with cloudpickle
+        require("cloudpickle", "--sizing with --tiles", "cloudpickle")
+    from . import distributed
+    if args.sizing_exr is not None:
+        try:
+            sizing = distributed.GridSource(args.sizing_exr, lo, hi, channel=args.channel,
+                                            radius_range=exr_range)
+        except (ValueError, OSError) as exc:
+            raise UsageError(f"--sizing-exr {args.sizing_exr}: {exc}") from None
     t0 = time.perf_counter()
     try:
         store = distributed.sample(args.output, dim, counts, l_bounds=lo, u_bounds=hi,
