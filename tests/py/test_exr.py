@@ -1,5 +1,6 @@
 """OpenEXR sizing images: files written with the OpenEXR package (float and half channels), and
 what the sampler sees of them (orientation, mapping of pixel values to radii, errors)."""
+import os
 import subprocess
 import sys
 
@@ -147,3 +148,21 @@ def test_cli_exr_range_needs_lo_hi(tmp_path, value):
     assert res.returncode == 2 and "Traceback" not in res.stderr, res.stderr
     assert f"--exr-range {value!r}" in res.stderr and "LO" in res.stderr
     assert len(res.stderr.strip().splitlines()) == 1
+
+
+def test_cli_without_openexr_names_the_install(tmp_path):
+    path = tmp_path / "y.exr"
+    write_exr(path, {"Y": np.full((4, 4), 0.05, np.float32)})
+    (tmp_path / "sitecustomize.py").write_text(
+        "import sys\n"
+        "class Block:\n"
+        "    def find_spec(self, name, path=None, target=None):\n"
+        "        if name.split('.')[0] == 'OpenEXR':\n"
+        "            raise ImportError(f'blocked: {name}')\n"
+        "sys.meta_path.insert(0, Block())\n")
+    env = dict(os.environ, PYTHONPATH=str(tmp_path))
+    for option in ("--sizing-exr", "--domain"):
+        res = subprocess.run([sys.executable, "-m", "vpds", "sample", option, str(path),
+                              "--no-progress"], capture_output=True, text=True, env=env)
+        assert res.returncode == 2 and "Traceback" not in res.stderr, res.stderr
+        assert option in res.stderr and "pip install OpenEXR" in res.stderr

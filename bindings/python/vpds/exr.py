@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Optional, Sequence, Union
 import numpy as np
 import numpy.typing as npt
 
+from ._optional import require
 from ._typing import BoundsLike
 
 if TYPE_CHECKING:  # for the annotation: sizing_grid_from_exr imports it itself, when called
@@ -24,11 +25,7 @@ def _channels(path: Union[str, PathLike[str]]) -> dict[str, npt.NDArray[np.float
     B (and A) into one channel 'RGB' or 'RGBA' of shape (rows, columns, 3 or 4), and a layer's
     into 'layer'; they are split here into R, G, B, A (and layer.R, ...) as the file names them.
     A file OpenEXR cannot open is a ValueError naming it."""
-    try:
-        import OpenEXR
-    except ImportError as exc:
-        raise ImportError("reading .exr sizing images needs the OpenEXR package "
-                          "(pip install OpenEXR)") from exc
+    OpenEXR = require("OpenEXR", "reading .exr images", "OpenEXR")
     try:
         try:
             f = OpenEXR.File(str(path), separate_channels=True)
