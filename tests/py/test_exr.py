@@ -166,3 +166,8 @@ def test_cli_without_openexr_names_the_install(tmp_path):
                               "--no-progress"], capture_output=True, text=True, env=env)
         assert res.returncode == 2 and "Traceback" not in res.stderr, res.stderr
         assert option in res.stderr and "pip install OpenEXR" in res.stderr
+    res = subprocess.run([sys.executable, "-m", "vpds", "sample", "--tiles", "2", "--sizing-exr",
+                          str(path), "-o", str(tmp_path / "t.zarr"), "--no-progress"],
+                         capture_output=True, text=True, env=env)
+    assert res.returncode == 2 and "Traceback" not in res.stderr, res.stderr
+    assert "--sizing-exr" in res.stderr and "pip install OpenEXR" in res.stderr

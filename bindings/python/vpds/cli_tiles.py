@@ -89,6 +89,8 @@ def cmd_sample_tiles(args: argparse.Namespace) -> int:
             raise UsageError("--lipschitz smooths an image in memory; with --tiles the "
                              "image is read per tile: smooth it first, or run without --tiles")
         exr_range = exr_range_arg(args.exr_range)
+        if str(args.sizing_exr).lower().endswith(".exr"):
+            require("OpenEXR", "--sizing-exr", "OpenEXR")
     periodic = periodic_arg(args.periodic, dim)
     # what the tiled run imports, asked for before any work: one line naming the pip install
     install = '"dask[distributed]" zarr'
