@@ -475,3 +475,18 @@ def test_mesh_option_mistakes_name_the_option(tmp_path, args, names):
     res = run_in(tmp_path, "sample", "--mesh", "tet.obj", *args, "--no-progress")
     assert_usage_error(res, *names)
     assert "box centre" not in res.stderr
+
+
+@pytest.mark.parametrize("where", ["sample", "mesh-run", "mesh-stream"])
+def test_a_stream_or_mesh_run_that_cannot_fit_is_refused_with_its_figure(tmp_path, where):
+    # the stream goes on to any count, and a mesh has no C estimate: both grew without end
+    if where == "sample":
+        args = ["sample", "--stream", "100000000000"]
+    else:
+        pytest.importorskip("trimesh")
+        (tmp_path / "tet.obj").write_text(TETRAHEDRON)
+        args = ["sample", "--mesh", "tet.obj"] + (["--radius", "1e-7"] if where == "mesh-run"
+                                                  else ["--stream", "100000000000"])
+    res = run_in(tmp_path, *args, "--no-progress", "-o", "out.npz")
+    assert_usage_error(res, "samples", "need at least", "MiB")
+    assert not (tmp_path / "out.npz").exists()

@@ -15,6 +15,7 @@ from typing import Any, Optional, Sequence
 import numpy as np
 import numpy.typing as npt
 
+from ._args import room_for_samples
 from ._core import MAX_DIM, RULES, PoissonDisk, VpdsError
 from ._optional import MissingDependencyError, require
 from ._typing import SizingFunction
@@ -59,6 +60,8 @@ def _sizing(args: argparse.Namespace, lo: npt.NDArray[np.float64], hi: npt.NDArr
 def _check_size(args: argparse.Namespace, engine: PoissonDisk, refine: list[float]) -> float:
     """The expected count; refuse a run that will not fit in memory unless --force."""
     if args.stream is not None:
+        # the stream goes on to any count: refuse one whose points alone cannot fit
+        room_for_samples(f"--stream {args.stream}", args.stream, engine.d)
         return float(args.stream)
     est = engine.estimate(min([1.0] + refine))
     avail = available_memory()
@@ -278,7 +281,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return int(args.func(args))
-    except (UsageError, MissingDependencyError, VpdsError, NotImplementedError) as exc:
+    except (UsageError, MissingDependencyError, VpdsError, NotImplementedError, MemoryError) as exc:
+        # a MemoryError here is a refusal before the work (its message gives the figure)
         print(f"vpds {args.command}: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

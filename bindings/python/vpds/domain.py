@@ -21,6 +21,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ._args import number
+from ._optional import require
 from ._callbacks import as_values, escaped, keep
 from ._errors import created
 from ._typing import BoundsLike, DomainFunction
@@ -162,10 +163,7 @@ def read_image(path: Union[str, os.PathLike[str]]) -> npt.NDArray[np.float64]:
     if str(path).lower().endswith(".exr"):
         from .exr import read_channel
         return read_channel(path)
-    try:
-        from PIL import Image
-    except ImportError as exc:
-        raise ImportError("reading image domains needs Pillow (pip install Pillow)") from exc
+    Image = require("PIL.Image", "reading image domains", "Pillow")
     with Image.open(path) as im:
         if im.mode in ("I;16", "I;16B", "I"):
             arr = np.asarray(im, dtype=np.float64) / (65535.0 if im.mode.startswith("I;16") else 1.0)

@@ -18,6 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ._errors import created
+from ._optional import require
 from ._typing import BoundsLike
 from ._vpds import ffi, lib
 
@@ -95,10 +96,7 @@ class GridSource:
 
     # -- OpenEXR: grid axis 0 = columns (x[0]), axis 1 = rows from the bottom (x[1]) ---------------
     def _exr_open(self) -> None:
-        try:
-            import OpenEXR
-        except ImportError as exc:
-            raise ImportError("reading .exr sizing images needs the OpenEXR package") from exc
+        OpenEXR = require("OpenEXR", "reading .exr sizing images", "OpenEXR")
         f = OpenEXR.InputFile(self._path)
         header = f.header()
         names = sorted(header["channels"])
