@@ -83,8 +83,13 @@ extern "C" {
  * so fewer cells split into 2^d children and fewer darts land where nothing is left (other
  * points for a run or refinement in 6D and up), and up to 5D the coverage search of two radii
  * and of a domain drops such a box too (the points of 11 except where the search's box budget
- * decided; everything else gives the points of 11). */
-#define VPDS_ALGORITHM_VERSION 12
+ * decided; everything else gives the points of 11). 13: in 1-4D the stream's search with a
+ * domain also tries, for a box whose centre lies outside the domain, the box's corners that lie
+ * in it, so that a domain meeting boxes only along their faces (a boundary on a plane the search
+ * splits at: x <= 0.5, an axis-aligned square, a mask of 2^k cells) is found there; 12 found no
+ * point along such a boundary and vpds_next gave up with VPDS_ERR_DOMAIN (other points for
+ * vpds_next with a domain; everything else gives the points of 12). */
+#define VPDS_ALGORITHM_VERSION 13
 /* Largest supported dimension; a larger dim is refused by vpds_create. */
 #define VPDS_MAX_DIM 16
 /* Relative tolerance eps of the continuous stream (vpds_next): each t it reports is an upper

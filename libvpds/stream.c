@@ -167,23 +167,26 @@ static vpds_status build_regions(vpdsi_stream *sm, const vpdsi_ctx *ctx)
 
 /* ---- the search inside one region ---- */
 
-/* Room for the 2^d children of one split (split_box, split_if_coarse). */
+/* Room for the 2^d children of one split (split_box, split_if_coarse): centres, g, bounds and
+ * where each g was found. */
 static int reserve_kids(vpdsi_stream *sm, vpdsi_mem *m)
 {
     size_t d = (size_t)sm->geom.dim, children = (size_t)1 << d;
-    return vpdsi_mem_reserve(m, (void **)&sm->kids, &sm->cap_kids, children * (d + 2),
+    return vpdsi_mem_reserve(m, (void **)&sm->kids, &sm->cap_kids, children * (2 * d + 2),
                              sizeof(double)) ||
            vpdsi_mem_reserve(m, (void **)&sm->kid_cells, &sm->cap_kid_cells, children * d,
                              sizeof(uint64_t));
 }
 
-/* The reserved room of one split: its children's centres (2^d * d), g and bounds (2^d each). */
-static void kid_arrays(const vpdsi_stream *sm, double **centres, double **g, double **ub)
+/* The reserved room of one split: its children's centres (2^d * d), g and bounds (2^d each),
+ * and the points g was found at (2^d * d). */
+static void kid_arrays(const vpdsi_stream *sm, double **centres, double **g, double **ub, double **at)
 {
     size_t children = (size_t)1 << sm->geom.dim;
     *centres = sm->kids;
     *g = sm->kids + children * (size_t)sm->geom.dim;
     *ub = *g + children;
+    *at = *ub + children;
 }
 
 /* The stream's relative tolerance (vpds.h): looser with a domain. */
@@ -250,12 +253,50 @@ oom:
     return VPDS_ERR_OUT_OF_MEMORY;
 }
 
+/* Version 13, up to this many dimensions: a box whose centre lies outside the domain is also
+ * tried at its corners (2^d of them). A domain that meets a box only along the box's faces or
+ * edges (a boundary on a plane the search splits at: x <= 0.5, an axis-aligned square, a mask of
+ * 2^k cells) held no centre of the boxes along it, at any depth: the search found no point there,
+ * its bound never fell, and it gave up with VPDS_ERR_DOMAIN. */
+#define STREAM_CORNER_DIM 4
+
+/* g at the corners of the box (centre c, half sides) that lie in the domain, the largest into
+ * *g and its corner into at when it beats *g (the domain's closed: sdf <= 0 is inside). */
+static vpds_status inside_corners(const vpdsi_ctx *ctx, const double *c, const double *half,
+                                  const int32_t *list, long count, double *g, double *at)
+{
+    const vpdsi_problem *pb = ctx->pb;
+    vpdsi_store *st = ctx->st;
+    vpdsi_kd_samples v = vpdsi_store_view(st);
+    int d = pb->dim, k;
+    unsigned b;
+    for (b = 0; b < 1u << d; b++) {
+        double y[VPDS_MAX_DIM], phi, ry = st->sizing.radius, q;
+        int32_t arg;
+        vpds_status e;
+        for (k = 0; k < d; k++) y[k] = (b >> k) & 1u ? c[k] + half[k] : c[k] - half[k];
+        if ((e = vpdsi_domain_at(ctx->dom, st, y, &phi)) != VPDS_OK) return e;
+        if (phi > 0) continue;
+        if (st->sizing.kind != VPDSI_SIZING_CONSTANT && (e = vpdsi_store_radius_at(st, y, &ry)) != VPDS_OK)
+            return e;
+        q = count >= 0 ? vpdsi_kd_list_min_ratio(&st->tree, &v, list, (size_t)count, y, 0.0, ry, (int)pb->rule, &arg)
+                       : vpdsi_kd_min_ratio(&st->tree, &v, y, 0.0, ry, (int)pb->rule, &arg);
+        if (q / pb->coverage > *g) {
+            *g = q / pb->coverage;
+            memcpy(at, y, (size_t)d * sizeof(double));
+        }
+    }
+    return VPDS_OK;
+}
+
 /* Exact g at each of n centres (and argmin), and an upper bound of g over the box of half
  * sides half around each: (|c - x*| + h) / f(r(x*), r(c) - L h), x* the argmin at c. list
  * (version 8, or NULL): in, the samples that may be nearest in the enclosing box (count < 0:
- * read the tree), out, those of these boxes (near_centres). */
+ * read the tree), out, those of these boxes (near_centres). at (or NULL): where each g was
+ * found, the centre or (version 13) a corner in the domain when the centre is not. */
 static vpds_status eval_boxes(vpdsi_stream *sm, const vpdsi_ctx *ctx, const double *centres,
-                              size_t n, const double *half, near_list *list, double *g, double *ub)
+                              size_t n, const double *half, near_list *list, double *g, double *ub,
+                              double *at)
 {
     const vpdsi_problem *pb = ctx->pb;
     vpdsi_store *st = ctx->st;
@@ -297,6 +338,13 @@ static vpds_status eval_boxes(vpdsi_stream *sm, const vpdsi_ctx *ctx, const doub
                                           c, 0.0, rc, (int)pb->rule, &arg)
                 : vpdsi_kd_min_ratio(&st->tree, &v, c, 0.0, rc, (int)pb->rule, &arg);
         g[j] = phi > 0 ? -1 : q / pb->coverage;
+        if (at) {
+            memcpy(at + j * (size_t)d, c, (size_t)d * sizeof(double));
+            if (phi > 0 && pb->algorithm >= 13 && d <= STREAM_CORNER_DIM &&
+                (e = inside_corners(ctx, c, half, list && list->count >= 0 ? sm->near + list->from : NULL,
+                                    list ? list->count : -1, &g[j], at + j * (size_t)d)) != VPDS_OK)
+                return e;
+        }
         if (arg < 0) {
             ub[j] = INFINITY;
             continue;
@@ -366,11 +414,11 @@ static vpds_status split_box(vpdsi_stream *sm, const vpdsi_ctx *ctx, region_sear
 {
     int d = sm->geom.dim, k;
     size_t w = BOX_WORDS(d), children = (size_t)1 << d, j;
-    double *cs, *gs, *ubs;
+    double *cs, *gs, *ubs, *ats;
     near_list list;
     int use;
     vpds_status e;
-    kid_arrays(sm, &cs, &gs, &ubs);
+    kid_arrays(sm, &cs, &gs, &ubs, &ats);
     for (j = 0; j < children; j++)
         for (k = 0; k < d; k++)
             cs[j * (size_t)d + (size_t)k] = cb[k] + ((j >> k) & 1u ? hb[k] : -hb[k]);
@@ -379,7 +427,7 @@ static vpds_status split_box(vpdsi_stream *sm, const vpdsi_ctx *ctx, region_sear
     /* a search that splits without end (a flat maximum) reads the tree once the lists hold
      * NEAR_POOL_MAX entries, so that its memory stays what it was without them */
     use = q->lists && sm->n_near < NEAR_POOL_MAX;
-    if ((e = eval_boxes(sm, ctx, cs, children, hb, use ? &list : NULL, gs, ubs)) != VPDS_OK)
+    if ((e = eval_boxes(sm, ctx, cs, children, hb, use ? &list : NULL, gs, ubs, ats)) != VPDS_OK)
         return e;
     if (vpdsi_mem_reserve(ctx->mem, (void **)&sm->boxes, &sm->cap_boxes,
                           (sm->n_boxes + children) * w, sizeof(double))) {
@@ -389,7 +437,7 @@ static vpds_status split_box(vpdsi_stream *sm, const vpdsi_ctx *ctx, region_sear
     for (j = 0; j < children; j++) {
         if (gs[j] > q->best) {
             q->best = gs[j];
-            memcpy(q->y, cs + j * (size_t)d, (size_t)d * sizeof(double));
+            memcpy(q->y, ats + j * (size_t)d, (size_t)d * sizeof(double));
         }
     }
     for (j = 0; j < children; j++) {
@@ -632,9 +680,8 @@ static vpds_status search_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, const d
     sm->n_near = 0;
     q.extra = -1;
     q.y = y;
-    if ((e = eval_boxes(sm, ctx, centre, 1, half, NULL, &g1, &ub1)) != VPDS_OK) return e;
+    if ((e = eval_boxes(sm, ctx, centre, 1, half, NULL, &g1, &ub1, y)) != VPDS_OK) return e;
     q.best = g1;
-    memcpy(y, centre, (size_t)d * sizeof(double));
     sm->n_boxes = 0;
     if (vpdsi_mem_reserve(ctx->mem, (void **)&sm->boxes, &sm->cap_boxes, w, sizeof(double))) {
         vpdsi_store_error(ctx->st, "out of memory in the stream's search");
@@ -835,11 +882,12 @@ static vpds_status split_if_coarse(vpdsi_stream *sm, const vpdsi_ctx *ctx, uint6
 {
     int d = sm->geom.dim, k, v3 = ctx->pb->algorithm >= 3;
     double key = rec_key(rec), h = 0, r, L = ctx->st->sizing.lipschitz, scale = key;
-    double *cs, *gs, *ubs, hs[VPDS_MAX_DIM];
+    double *cs, *gs, *ubs, *ats, hs[VPDS_MAX_DIM];
     unsigned level = (unsigned)rec[1];
     uint64_t b, n = 0, *cc = sm->kid_cells, cr[VPDS_MAX_DIM];
     vpds_status e;
-    kid_arrays(sm, &cs, &gs, &ubs);
+    kid_arrays(sm, &cs, &gs, &ubs, &ats);
+    (void)ats; /* only the keys are read here */
     *split = 0;
     if (v3 && scale > t_cap) scale = t_cap;
     if (!isfinite(scale) || level >= sm->max_level) return VPDS_OK;
@@ -860,7 +908,7 @@ static vpds_status split_if_coarse(vpdsi_stream *sm, const vpdsi_ctx *ctx, uint6
     /* every callback answers before the heap changes (vpdsi_stream_next) */
     if (v3 && !isfinite(key) && n > 0) {
         for (k = 0; k < d; k++) hs[k] = 0.5 * half[k];
-        if ((e = eval_boxes(sm, ctx, cs, (size_t)n, hs, NULL, gs, ubs)) != VPDS_OK) return e;
+        if ((e = eval_boxes(sm, ctx, cs, (size_t)n, hs, NULL, gs, ubs, NULL)) != VPDS_OK) return e;
     }
     *split = 1;
     heap_pop(sm, rec);
@@ -885,7 +933,7 @@ static vpds_status bound_region(vpdsi_stream *sm, const vpdsi_ctx *ctx, double k
      * maximiser only when it is within the tolerance of the key */
     if (*gy >= 0 && (!v3 || *gy * (1 + tol) >= key)) {
         double g1, ub1, zero[VPDS_MAX_DIM] = {0};
-        vpds_status e = eval_boxes(sm, ctx, y, 1, zero, NULL, &g1, &ub1);
+        vpds_status e = eval_boxes(sm, ctx, y, 1, zero, NULL, &g1, &ub1, NULL);
         if (e != VPDS_OK) return e;
         /* (the exact search's g(y) is its own arithmetic's: equal to round-off) */
         if (g1 == *gy || (exact && g1 >= *gy * (1 - EXACT_ROUNDING))) {

@@ -38,6 +38,14 @@ static double steep(const double *x, void *u) { (void)u; return 3 * (x[0] - 0.5)
 /* sdf <= 0 only on the face x0 = 0: a domain without area, where the coverage search splits
  * boxes along the face down to its precision at every cell */
 static double face(const double *x, void *u) { (void)u; return 0.5 * x[0]; }
+/* boundaries on the planes the stream's search splits at (x = 0.5, 0.25, 0.75) */
+static double half_plane(const double *x, void *u) { (void)u; return x[0] - 0.5; }
+static double prism(const double *x, void *u)
+{
+    double a = fabs(x[0] - 0.5), b = fabs(x[1] - 0.5);
+    (void)u;
+    return (a > b ? a : b) - 0.25;
+}
 
 /* A budget bounds a call's work, the coverage search's boxes included: on the face domain with
  * two radii one call of budget 3000 evaluated the domain about 290,000 times (a second of work)
@@ -151,7 +159,15 @@ static void check_stream(const setup *c, size_t n, const double *extra, size_t n
     vpds_sampler *s = make(c, 9);
     double *ts = (double *)malloc(n * sizeof(double)), x[3];
     size_t i, q;
-    for (i = 0; i < n; i++) CHECK(vpds_next(s, 0, x, ts + i) == VPDS_OK);
+    for (i = 0; i < n; i++) {
+        vpds_status st = vpds_next(s, 0, x, ts + i);
+        CHECK_MSG(st == VPDS_OK, "%s: event %zu: %s", what, i, vpds_last_error(s));
+        if (st != VPDS_OK) { /* the prefixes below read only the events there were */
+            free(ts);
+            vpds_destroy(s);
+            return;
+        }
+    }
     CHECK(isinf(ts[0]));
     for (q = 1; q <= 3; q++) {
         size_t m = n * q / 3 - 1;
@@ -162,6 +178,55 @@ static void check_stream(const setup *c, size_t n, const double *extra, size_t n
     }
     free(ts);
     vpds_destroy(s);
+}
+
+/* Version 13: domains whose boundary lies on the planes the stream's search splits at. Version
+ * 12's search found no point along such a boundary from the outside boxes (no centre lies in
+ * the domain there, at any depth) and gave up with VPDS_ERR_DOMAIN after a few events. */
+static void check_aligned_streams(void)
+{
+    static const double square[] = {0.25, 0.25, 0.75, 0.25, 0.75, 0.75, 0.25, 0.75};
+    static const size_t square_sizes[] = {4};
+    static const double cells[16] = {0, 0, 0, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 0, 0, 0};
+    size_t shape[2] = {4, 4};
+    vpds_polygon_desc pd = vpds_default_polygon_desc();
+    vpds_mask_desc md = vpds_default_mask_desc();
+    vpds_polygon *poly;
+    vpds_mask *mask;
+    setup c = {2, VPDS_RULE_SMALLER, 1.0, half_plane, NULL, NULL, 0.05};
+    size_t n = quick ? 100 : 300;
+    check_stream(&c, n, NULL, 0, "stream in the half-plane x <= 0.5");
+    pd.xy = square;
+    pd.ring_sizes = square_sizes;
+    pd.n_rings = 1;
+    CHECK(vpds_polygon_create(&pd, &poly) == VPDS_OK);
+    c.sdf = vpds_polygon_sdf;
+    c.user = poly;
+    check_stream(&c, n, NULL, 0, "stream in the square polygon [0.25, 0.75]^2");
+    md.shape = shape;
+    md.values = cells;
+    CHECK(vpds_mask_create(&md, &mask) == VPDS_OK);
+    c.sdf = vpds_mask_sdf;
+    c.user = mask;
+    check_stream(&c, n, NULL, 0, "stream in a 4x4 mask (its middle 2x2 inside)");
+    c.dim = 3;
+    c.sdf = prism;
+    c.user = NULL;
+    c.radius = 0.1;
+    check_stream(&c, n, NULL, 0, "stream in the 3D prism |x - 0.5|, |y - 0.5| <= 0.25");
+    {
+        /* version 12 still gives up there: its points are kept as they were */
+        vpds_desc d = vpds_default_desc();
+        vpds_sampler *s;
+        size_t got;
+        d.domain = half_plane;
+        d.algorithm_version = 12;
+        CHECK(vpds_create(&d, &s) == VPDS_OK);
+        CHECK(vpds_next_n(s, 100, 0.0, NULL, NULL, &got) == VPDS_ERR_DOMAIN && got < 100);
+        vpds_destroy(s);
+    }
+    vpds_polygon_destroy(poly);
+    vpds_mask_destroy(mask);
 }
 
 /* Points along the rings of a polygon (every edge, 20 per edge). */
@@ -304,6 +369,7 @@ int main(void)
     c.radius = 0.06;
     check_run(&c, NULL, 0, "torus");
     check_stream(&c, quick ? 100 : 400, NULL, 0, "torus stream");
+    check_aligned_streams();
 
     /* bad domains: each a clear error, nothing changed */
     {

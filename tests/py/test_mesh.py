@@ -186,8 +186,10 @@ def test_algorithm_version_pins_the_mesh_stream():
                                   current.points)
     np.testing.assert_array_equal(vpds.sample_mesh(m, radius=0.2, n=80, rng=3, algorithm_version=12).points,
                                   current.points)
-    for bad in (2, 13, -1, 1.5, True):
-        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 3\.\.12"):
+    np.testing.assert_array_equal(vpds.sample_mesh(m, radius=0.2, n=80, rng=3, algorithm_version=13).points,
+                                  current.points)
+    for bad in (2, 14, -1, 1.5, True):
+        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 3\.\.13"):
             vpds.sample_mesh(m, algorithm_version=bad)
 
 

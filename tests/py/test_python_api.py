@@ -226,9 +226,10 @@ def test_algorithm_version_pins_the_points():
     in 5D and 6D (2D streams and every run keep the points of 8); version 10 finds the 2D
     stream's farthest point from the Voronoi diagram (the same largest gaps, other bits; every
     run keeps its points); version 11 does the same in 3D; version 12 drops the cells two disks
-    hold together from 6D on (other points there, the same below); a version the library does
-    not have is refused."""
-    assert vpds.ALGORITHM_VERSION == 12
+    hold together from 6D on (other points there, the same below); version 13 finds the stream's
+    points with a domain along a boundary on the search's split planes, where 12 gave up (every
+    run keeps its points); a version the library does not have is refused."""
+    assert vpds.ALGORITHM_VERSION == 13
 
     def fill(version, inhibition):
         engine = vpds.PoissonDisk(2, sizing=lambda x: 0.04 + 0.04 * x[:, 0], lipschitz=0.04,
@@ -246,6 +247,7 @@ def test_algorithm_version_pins_the_points():
     assert np.array_equal(current, fill(10, 0.6))
     assert np.array_equal(current, fill(11, 0.6))
     assert np.array_equal(current, fill(12, 0.6))
+    assert np.array_equal(current, fill(13, 0.6))
     assert np.array_equal(current, v3)
     assert np.array_equal(v2, v3)
     assert not np.array_equal(v1, v2)
@@ -298,6 +300,6 @@ def test_algorithm_version_pins_the_points():
     assert np.array_equal(fill6(None), fill6(12))
     assert not np.array_equal(fill6(12), fill6(11))
     assert np.array_equal(fill6(11), fill6(10))
-    for bad in (13, -1, 1.5, True):
-        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.12"):
+    for bad in (14, -1, 1.5, True):
+        with pytest.raises(ValueError, match=r"algorithm_version = .*versions 1\.\.13"):
             vpds.PoissonDisk(2, algorithm_version=bad)
