@@ -326,7 +326,8 @@ VPDS_API const double *vpds_grid_values(const vpds_grid *grid);
 VPDS_API size_t vpds_grid_size(const vpds_grid *grid);
 
 /* ---- Built-in domains: set desc.domain = vpds_polygon_sdf (or vpds_mask_sdf) and
- * desc.domain_user = the object; it must outlive the samplers that use it. */
+ * desc.domain_user = the object; it must outlive the samplers that use it. A sampler of another
+ * dimension than the domain's (2 for a polygon, the mask's axes) is refused by vpds_validate. */
 
 /* A 2D polygon set with holes: rings of vertices, closed implicitly; a point is inside when a
  * ray from it crosses the rings an odd number of times (a ring inside another is a hole). */

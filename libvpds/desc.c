@@ -1,6 +1,7 @@
 /* The sampler's descriptor: defaults, and the validation that explains every refusal. */
 #include "desc.h"
 #include "grid.h"
+#include "mask.h"
 #include "refuse.h"
 #include "rules.h"
 #include "sizing.h"
@@ -126,6 +127,15 @@ vpds_status vpds_validate(const vpds_desc *d, char *msg, size_t cap)
                        k, side, 2 * d->coverage * d->radius);
         }
     }
+    /* the built-in domains know their dimension: one of another would be read at coordinates
+     * the sampler never writes (a mask's extra axes) or never read (its missing ones) */
+    if (d->domain == vpds_polygon_sdf && d->dim != 2)
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.domain is vpds_polygon_sdf, a 2D domain; desc.dim = %d",
+                     d->dim);
+    if (d->domain == vpds_mask_sdf && vpdsi_mask_dim(d->domain_user) > 0 &&
+        vpdsi_mask_dim(d->domain_user) != d->dim)
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.domain_user: a %dD mask (vpds_mask_sdf) for desc.dim = %d",
+                     vpdsi_mask_dim(d->domain_user), d->dim);
     if (d->weighted && callback && !(d->radius_min > 0))
         VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.weighted with a sizing callback needs desc.radius_min "
                "> 0 (a lower bound of r: darts are kept with probability (radius_min / r)^dim)");

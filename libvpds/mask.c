@@ -4,6 +4,7 @@
  * their half difference is too, and it is -h/2 and +h/2 across a boundary of cells h apart.
  * The multilinear interpolant between centres (the grid sizing's) can be up to sqrt(d) times
  * steeper; its exact constant L is computed and the values divided by it when above 1. */
+#include "mask.h"
 #include "grid.h"
 #include "refuse.h"
 #include <math.h>
@@ -220,4 +221,10 @@ double vpds_mask_sdf(const double *x, void *user)
     const vpds_mask *mk = (const vpds_mask *)user;
     if (!mk || mk->magic != VPDSI_MASK_COOKIE || !x) return NAN;
     return mk->scale * vpds_grid_eval(mk->grid, x);
+}
+
+int vpdsi_mask_dim(const void *user)
+{
+    const vpds_mask *mk = (const vpds_mask *)user;
+    return mk && mk->magic == VPDSI_MASK_COOKIE ? mk->grid->dim : 0;
 }

@@ -1,4 +1,5 @@
 #include "store.h"
+#include "torus.h"
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -318,10 +319,8 @@ vpds_status vpdsi_store_lipschitz_broken(vpdsi_store *st, const double *y, doubl
 {
     char py[256], px[256];
     const double *x = st->x + (size_t)i * (size_t)st->dim;
-    double dist = 0;
-    int k;
-    for (k = 0; k < st->dim; k++) dist += (y[k] - x[k]) * (y[k] - x[k]);
-    dist = sqrt(dist);
+    /* the distance the check read: across the wrap on a periodic axis */
+    double dist = sqrt(vpdsi_torus_dist2(y, x, st->dim, st->period));
     vpdsi_format_point(py, sizeof py, y, st->dim);
     vpdsi_format_point(px, sizeof px, x, st->dim);
     vpdsi_store_error(st, "sizing breaks lipschitz = %g: r = %.17g at (%s) and r = %.17g at (%s), "

@@ -383,6 +383,42 @@ int main(void)
         CHECK(vpds_run(s) == VPDS_ERR_DOMAIN && !vpds_get_stats(s).maximal);
         CHECK(vpds_next(s, 0, x, &t) == VPDS_ERR_DOMAIN && vpds_count(s) == 0);
         vpds_destroy(s);
+        {
+            /* the built-in domains know their dimension: one of another is refused at create
+             * (a 2D mask was read at a 1D sampler's unwritten second coordinate) */
+            static const double cells4[16] = {0, 0, 0, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 0, 0, 0};
+            static const double tri[] = {0.1, 0.1, 0.9, 0.1, 0.5, 0.9};
+            static const size_t tri_sizes[] = {3};
+            size_t shape4[2] = {4, 4};
+            vpds_mask_desc md = vpds_default_mask_desc();
+            vpds_polygon_desc pd = vpds_default_polygon_desc();
+            vpds_mask *m2;
+            vpds_polygon *p2;
+            vpds_desc e = vpds_default_desc();
+            md.shape = shape4;
+            md.values = cells4;
+            CHECK(vpds_mask_create(&md, &m2) == VPDS_OK);
+            pd.xy = tri;
+            pd.ring_sizes = tri_sizes;
+            pd.n_rings = 1;
+            CHECK(vpds_polygon_create(&pd, &p2) == VPDS_OK);
+            e.domain = vpds_mask_sdf;
+            e.domain_user = m2;
+            e.dim = 1;
+            CHECK(vpds_validate(&e, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT && strstr(msg, "a 2D mask"));
+            e.dim = 3;
+            CHECK(vpds_create(&e, &s) == VPDS_ERR_INVALID_ARGUMENT && s == NULL);
+            e.dim = 2;
+            CHECK(vpds_validate(&e, msg, sizeof msg) == VPDS_OK);
+            e.domain = vpds_polygon_sdf;
+            e.domain_user = p2;
+            e.dim = 3;
+            CHECK(vpds_validate(&e, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT && strstr(msg, "a 2D domain"));
+            e.dim = 2;
+            CHECK(vpds_validate(&e, msg, sizeof msg) == VPDS_OK);
+            vpds_mask_destroy(m2);
+            vpds_polygon_destroy(p2);
+        }
         d.domain = nan_far;
         CHECK(vpds_create(&d, &s) == VPDS_OK);
         CHECK(vpds_run(s) == VPDS_ERR_DOMAIN && strstr(vpds_last_error(s), "NaN"));

@@ -19,6 +19,7 @@ static double ramp(const double *x, void *u) { (void)u; return 0.001 + 0.3 * x[0
 static double big(const double *x, void *u) { (void)x; (void)u; return 0.6; }
 static void *only_alloc(size_t n, void *u) { (void)u; return malloc(n); }
 static double steep(const double *x, void *u) { (void)u; return 0.01 + 0.4 * x[0]; }
+static double seam(const double *x, void *u) { (void)u; return 0.03 + 0.04 * x[0]; }
 
 /* Returns a bad value at the k-th call (0: never), chosen by *mode. */
 typedef struct { int calls, bad_at; double bad; } flaky_t;
@@ -174,6 +175,18 @@ int main(void)
     }
     CHECK(vpds_count(s) > 0);
     vpds_destroy(s);
+    {
+        /* across a periodic seam: r jumps from 0.07 back to 0.03, and the message's distance and
+         * slope are the wrapped ones the check read (they were the unwrapped, a slope below L) */
+        int periodic[2] = {1, 0};
+        const char *slope;
+        d = vpds_default_desc(); d.sizing = seam; d.lipschitz = 0.05; d.periodic = periodic;
+        CHECK(vpds_create(&d, &s) == VPDS_OK);
+        CHECK(vpds_run(s) == VPDS_ERR_LIPSCHITZ);
+        slope = strstr(vpds_last_error(s), "slope ");
+        CHECK_MSG(slope && atof(slope + 6) > 0.05, "%s", vpds_last_error(s));
+        vpds_destroy(s);
+    }
 
     /* fixed points */
     d = vpds_default_desc();
