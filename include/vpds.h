@@ -320,7 +320,7 @@ VPDS_API double vpds_grid_lipschitz(const vpds_grid *grid);
 /* Lower values, as little as the sufficient condition "every edge slope <= L/sqrt(dim)"
  * allows (the largest such function below the grid), so that the interpolant is L-Lipschitz. */
 VPDS_API vpds_status vpds_grid_enforce_lipschitz(vpds_grid *grid, double lipschitz);
-/* r at x (coordinates outside [lo, hi] are clamped). */
+/* r at x (coordinates outside [lo, hi] are clamped; NaN where a coordinate is NaN). */
 VPDS_API double vpds_grid_eval(const vpds_grid *grid, const double *x);
 VPDS_API const double *vpds_grid_values(const vpds_grid *grid);
 VPDS_API size_t vpds_grid_size(const vpds_grid *grid);
@@ -342,8 +342,9 @@ typedef struct vpds_polygon_desc {
 } vpds_polygon_desc;
 
 VPDS_API vpds_polygon_desc vpds_default_polygon_desc(void);
-/* Refuses non-finite vertices, repeated consecutive vertices, and edges that cross or touch
- * (within a ring or between rings), naming the edges and the point. */
+/* Refuses non-finite vertices, repeated consecutive vertices, edges that cross or touch
+ * (within a ring or between rings), naming the edges and the point, and a ring that encloses
+ * no area at its coordinates' precision (darts could never land in it). */
 VPDS_API vpds_status vpds_polygon_validate(const vpds_polygon_desc *desc, char *msg, size_t cap);
 VPDS_API vpds_status vpds_polygon_create(const vpds_polygon_desc *desc, vpds_polygon **out);
 VPDS_API void vpds_polygon_destroy(vpds_polygon *polygon);

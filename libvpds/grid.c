@@ -202,7 +202,8 @@ double vpds_grid_eval(const vpds_grid *g, const double *x)
     for (k = 0; k < d; k++) {
         double u = (x[k] - g->lo[k]) / g->step[k], fl;
         size_t i;
-        if (!(u > 0)) u = 0; /* also maps NaN to the first node */
+        if (u != u) return NAN; /* a NaN coordinate has no value (it read the first node's) */
+        if (!(u > 0)) u = 0;
         if (u > (double)(g->whole[k] - 1)) u = (double)(g->whole[k] - 1);
         fl = floor(u);
         i = (size_t)fl;

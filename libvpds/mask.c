@@ -7,6 +7,7 @@
 #include "mask.h"
 #include "grid.h"
 #include "refuse.h"
+#include "sizing.h"
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -61,6 +62,12 @@ vpds_status vpds_mask_validate(const vpds_mask_desc *d, char *msg, size_t cap)
         if (!isfinite(lo) || !isfinite(hi) || !(lo < hi) || !isfinite(hi - lo))
             VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "mask desc: axis %zu has lo = %g, hi = %g; need finite lo < hi",
                  k, lo, hi);
+        /* the sampler's own bounds: past them the distances' squares overflow (NaN everywhere)
+         * or underflow (0 everywhere: every cell inside) */
+        if (fabs(lo) > VPDSI_MAGNITUDE_MAX || fabs(hi) > VPDSI_MAGNITUDE_MAX || hi - lo < VPDSI_MAGNITUDE_MIN)
+            VPDSI_REFUSE(VPDS_ERR_OVERFLOW, "mask desc: axis %zu has lo = %g, hi = %g; coordinates must stay "
+                 "within 1e150 in magnitude and the extent at least 1e-150 (squared distances overflow or "
+                 "underflow beyond)", k, lo, hi);
     }
     for (i = 0; i < n; i++) {
         if (isnan(d->values[i])) VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "mask desc: values[%zu] is NaN", i);

@@ -134,6 +134,10 @@ static vpds_status validate_arrays(const vpds_mesh_desc *d, char *msg, size_t ca
 {
     size_t i, n_live = 0;
     int k;
+    if (!d->vertices && d->n_vertices > 0)
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.vertices is NULL (n_vertices = %zu)", d->n_vertices);
+    if (!d->triangles && d->n_triangles > 0)
+        VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.triangles is NULL (n_triangles = %zu)", d->n_triangles);
     if (!d->vertices || d->n_vertices == 0)
         VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "desc.vertices: no vertices (n_vertices = %zu)", d->n_vertices);
     if (!d->triangles || d->n_triangles == 0)

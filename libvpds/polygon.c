@@ -36,6 +36,9 @@ typedef struct {
     size_t a, b;       /* vertex indices into xy */
 } poly_edge;
 
+/* A ring whose area is below this fraction of its width squared is flat to round-off. */
+#define POLYGON_FLAT 1e-12
+
 static int by_xmin(const void *p, const void *q)
 {
     double a = ((const poly_edge *)p)->xmin, b = ((const poly_edge *)q)->xmin;
@@ -153,6 +156,21 @@ vpds_status vpds_polygon_validate(const vpds_polygon_desc *d, char *msg, size_t 
         }
     }
     vpdsi_mem_free(&m, edges, total * sizeof *edges);
+    /* a ring flat to round-off (a triangle 1e-300 high) passes the tests above, and a run in it
+     * splits cells without end waiting for a dart to land inside */
+    for (r = 0, at = 0; r < d->n_rings; at += d->ring_sizes[r], r++) {
+        size_t n = d->ring_sizes[r];
+        const double *o = d->xy + 2 * at;
+        double area = 0, wide = 0;
+        for (j = 0; j < n; j++) {
+            const double *p = d->xy + 2 * (at + j), *q = d->xy + 2 * (at + (j + 1) % n);
+            area += (p[0] - o[0]) * (q[1] - o[1]) - (q[0] - o[0]) * (p[1] - o[1]);
+            wide = fmax(wide, fmax(fabs(p[0] - o[0]), fabs(p[1] - o[1])));
+        }
+        if (!(fabs(area) > POLYGON_FLAT * wide * wide))
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "polygon desc: ring %zu encloses no area at the precision "
+                 "of its coordinates (area %g in a ring %g wide)", r, 0.5 * fabs(area), wide);
+    }
     return VPDS_OK;
 }
 

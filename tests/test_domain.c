@@ -449,6 +449,27 @@ int main(void)
             CHECK(vpds_mask_validate(&md, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT &&
                   strstr(msg, "no value"));
             CHECK(vpds_mask_create(&md, &m) == VPDS_ERR_INVALID_ARGUMENT && m == NULL);
+            {
+                /* a ring flat to round-off (a run in it split cells without end), and a mask's box
+                 * past the sampler's bounds (its distances NaN, or 0 everywhere) */
+                static const double flat[] = {0, 0, 1, 0, 0.5, 1e-300};
+                static const double thin[] = {0, 0, 1, 0, 0.5, 1e-9};
+                static const size_t three[] = {3};
+                static const double some[4] = {0, 1, 1, 0};
+                double lo[2] = {0, 0}, huge[2] = {1e300, 1e300}, tiny[2] = {1e-300, 1e-300};
+                pd.xy = flat;
+                pd.ring_sizes = three;
+                CHECK(vpds_polygon_validate(&pd, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT &&
+                      strstr(msg, "ring 0 encloses no area"));
+                pd.xy = thin; /* thin, not flat: taken (and slow to sample, as the README says) */
+                CHECK(vpds_polygon_validate(&pd, msg, sizeof msg) == VPDS_OK);
+                md.values = some;
+                md.lo = lo;
+                md.hi = huge;
+                CHECK(vpds_mask_validate(&md, msg, sizeof msg) == VPDS_ERR_OVERFLOW && strstr(msg, "1e150"));
+                md.hi = tiny;
+                CHECK(vpds_mask_create(&md, &m) == VPDS_ERR_OVERFLOW && m == NULL);
+            }
         }
     }
     CHECK_DONE();

@@ -62,6 +62,8 @@ int main(void)
         CHECK(fabs(vpds_grid_eval(g, p) - 2.0) < 1e-15);
         p[0] = -5; p[1] = 7; /* clamped to the corner (0, 1) */
         CHECK(vpds_grid_eval(g, p) == 2.0);
+        p[0] = NAN; /* no value at no point (it read the first node's) */
+        CHECK(isnan(vpds_grid_eval(g, p)));
         vpds_grid_destroy(g);
     }
     /* random 3D grid: values at nodes, exact L bounds every observed slope and is approached */

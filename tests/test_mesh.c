@@ -674,6 +674,12 @@ static void test_bad_input(void)
     d.n_triangles = 0;
     expect_refused(&d, VPDS_ERR_INVALID_ARGUMENT, "at least one triangle");
     d = desc_for(&sq);
+    d.vertices = NULL; /* a missing array is named as such, not as a mesh with no vertices */
+    expect_refused(&d, VPDS_ERR_INVALID_ARGUMENT, "desc.vertices is NULL");
+    d = desc_for(&sq);
+    d.triangles = NULL;
+    expect_refused(&d, VPDS_ERR_INVALID_ARGUMENT, "desc.triangles is NULL");
+    d = desc_for(&sq);
     keep = sq.v[3 * 5 + 1];
     sq.v[3 * 5 + 1] = NAN;
     expect_refused(&d, VPDS_ERR_INVALID_ARGUMENT, "vertex 5 coordinate 1");
