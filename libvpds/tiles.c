@@ -521,6 +521,25 @@ static size_t tiles_gather(const vpds_tiling *t, const uint64_t *c, const uint64
     return count;
 }
 
+/* The points of deps[i] as vpds_add_points takes them, named by their place in deps: an infinite
+ * coordinate was dropped as out of reach, and a NaN was refused under the index of the tile's
+ * own gathered list. */
+static vpds_status tiles_check_points(const vpds_tile_points *p, size_t i, int d, char *msg, size_t cap)
+{
+    size_t q;
+    int k;
+    for (q = 0; q < p->n; q++) {
+        for (k = 0; k < d; k++)
+            if (!(fabs(p->x[q * (size_t)d + (size_t)k]) <= VPDSI_MAGNITUDE_MAX))
+                VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "deps[%zu].x[%zu][%d] = %g: the samples of a "
+                             "dependency must be finite (within 1e150)", i, q, k, p->x[q * (size_t)d + (size_t)k]);
+        if (!vpdsi_radius_ok(p->r[q]))
+            VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "deps[%zu].r[%zu] = %g: radii must be finite and > 0 "
+                         "(within [1e-100, 1e100])", i, q, p->r[q]);
+    }
+    return VPDS_OK;
+}
+
 /* Which entry of deps is which dependency of the tile (dep, n_dep of them): each exactly once,
  * nothing else; order[j] is the entry holding dep[j]. */
 static vpds_status tiles_match_deps(const vpds_tiling *t, uint64_t tile, int phase,
@@ -544,6 +563,7 @@ static vpds_status tiles_match_deps(const vpds_tiling *t, uint64_t tile, int pha
         if (deps[i].n && (!deps[i].x || !deps[i].r))
             VPDSI_REFUSE(VPDS_ERR_INVALID_ARGUMENT, "deps[%zu] (tile %llu): x or r is NULL with "
                          "n = %zu", i, (unsigned long long)deps[i].tile, deps[i].n);
+        if (tiles_check_points(&deps[i], i, t->dim, msg, cap) != VPDS_OK) return VPDS_ERR_INVALID_ARGUMENT;
         order[j] = i;
     }
     for (j = 0; j < n_dep; j++)

@@ -490,6 +490,21 @@ static void check_errors(void)
     CHECK(vpds_tile_create(tg, 1, pts, 1, NULL, &s, &nf, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT);
     CHECK_MSG(strstr(msg, "x or r is NULL with n = 1") != NULL, "%s", msg);
     pts[0].x = x;
+    {
+        /* a dependency's bad sample is named by its place in deps (an infinite one was dropped
+         * as out of reach, a NaN named by its place in the tile's own list) */
+        double bad_x[4] = {0.24, 0.24, 0.1, INFINITY}, bad_r[2] = {r[0], r[0]};
+        pts[1].tile = 6; pts[1].x = bad_x; pts[1].r = bad_r; pts[1].n = 2;
+        pts[2].tile = 2; pts[2].n = 0;
+        pts[3].tile = 4; pts[3].n = 0;
+        CHECK(vpds_tile_create(tg, 1, pts, 4, NULL, &s, &nf, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT);
+        CHECK_MSG(strstr(msg, "deps[1].x[1][1] = inf") != NULL, "%s", msg);
+        bad_x[3] = 0.1;
+        bad_r[1] = NAN;
+        CHECK(vpds_tile_create(tg, 1, pts, 4, NULL, &s, &nf, msg, sizeof msg) == VPDS_ERR_INVALID_ARGUMENT);
+        CHECK_MSG(strstr(msg, "deps[1].r[1] = nan") != NULL, "%s", msg);
+        pts[1] = pts[0];
+    }
     /* tile 1 = (0, 1), phase 2, needs 0, 2, 4 and 6; only tile 0 holds a point */
     pts[1].tile = 6; pts[1].n = 0;
     pts[2].tile = 2; pts[2].n = 0;
