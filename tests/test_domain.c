@@ -180,6 +180,32 @@ static void check_stream(const setup *c, size_t n, const double *extra, size_t n
     vpds_destroy(s);
 }
 
+/* A polygon of n_rings rings, created (the setup several checks share). */
+static vpds_polygon *polygon_of(const double *xy, const size_t *ring_sizes, size_t n_rings)
+{
+    vpds_polygon_desc pd = vpds_default_polygon_desc();
+    vpds_polygon *p = NULL;
+    pd.xy = xy;
+    pd.ring_sizes = ring_sizes;
+    pd.n_rings = n_rings;
+    CHECK(vpds_polygon_create(&pd, &p) == VPDS_OK);
+    return p;
+}
+
+/* A 4x4 mask of the unit square whose middle 2x2 cells are inside: its boundary lies on the
+ * planes x, y = 0.25, 0.75. */
+static vpds_mask *middle_of_4x4(void)
+{
+    static const double cells[16] = {0, 0, 0, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 0, 0, 0};
+    size_t shape[2] = {4, 4};
+    vpds_mask_desc md = vpds_default_mask_desc();
+    vpds_mask *m = NULL;
+    md.shape = shape;
+    md.values = cells;
+    CHECK(vpds_mask_create(&md, &m) == VPDS_OK);
+    return m;
+}
+
 /* Version 13: domains whose boundary lies on the planes the stream's search splits at. Version
  * 12's search found no point along such a boundary from the outside boxes (no centre lies in
  * the domain there, at any depth) and gave up with VPDS_ERR_DOMAIN after a few events. */
@@ -187,25 +213,14 @@ static void check_aligned_streams(void)
 {
     static const double square[] = {0.25, 0.25, 0.75, 0.25, 0.75, 0.75, 0.25, 0.75};
     static const size_t square_sizes[] = {4};
-    static const double cells[16] = {0, 0, 0, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 0, 0, 0};
-    size_t shape[2] = {4, 4};
-    vpds_polygon_desc pd = vpds_default_polygon_desc();
-    vpds_mask_desc md = vpds_default_mask_desc();
-    vpds_polygon *poly;
-    vpds_mask *mask;
+    vpds_polygon *poly = polygon_of(square, square_sizes, 1);
+    vpds_mask *mask = middle_of_4x4();
     setup c = {2, VPDS_RULE_SMALLER, 1.0, half_plane, NULL, NULL, 0.05};
     size_t n = quick ? 100 : 300;
     check_stream(&c, n, NULL, 0, "stream in the half-plane x <= 0.5");
-    pd.xy = square;
-    pd.ring_sizes = square_sizes;
-    pd.n_rings = 1;
-    CHECK(vpds_polygon_create(&pd, &poly) == VPDS_OK);
     c.sdf = vpds_polygon_sdf;
     c.user = poly;
     check_stream(&c, n, NULL, 0, "stream in the square polygon [0.25, 0.75]^2");
-    md.shape = shape;
-    md.values = cells;
-    CHECK(vpds_mask_create(&md, &mask) == VPDS_OK);
     c.sdf = vpds_mask_sdf;
     c.user = mask;
     check_stream(&c, n, NULL, 0, "stream in a 4x4 mask (its middle 2x2 inside)");
@@ -295,15 +310,8 @@ int main(void)
     check_stream(&c, quick ? 200 : 500, circles, n_circles, "annulus stream");
 
     /* polygons: the L-shape and the square with a hole */
-    pd = vpds_default_polygon_desc();
-    pd.xy = l_xy;
-    pd.ring_sizes = l_sizes;
-    pd.n_rings = 1;
-    CHECK(vpds_polygon_create(&pd, &lshape) == VPDS_OK);
-    pd.xy = h_xy;
-    pd.ring_sizes = h_sizes;
-    pd.n_rings = 2;
-    CHECK(vpds_polygon_create(&pd, &holed) == VPDS_OK);
+    lshape = polygon_of(l_xy, l_sizes, 1);
+    holed = polygon_of(h_xy, h_sizes, 2);
     {
         double p_in[2] = {0.2, 0.2}, p_out[2] = {0.6, 0.6}, p_hole[2] = {0.5, 0.5};
         CHECK(vpds_polygon_sdf(p_in, lshape) == -0.1 || fabs(vpds_polygon_sdf(p_in, lshape) + 0.1) < 1e-15);
@@ -386,22 +394,11 @@ int main(void)
         {
             /* the built-in domains know their dimension: one of another is refused at create
              * (a 2D mask was read at a 1D sampler's unwritten second coordinate) */
-            static const double cells4[16] = {0, 0, 0, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 0, 0, 0};
             static const double tri[] = {0.1, 0.1, 0.9, 0.1, 0.5, 0.9};
             static const size_t tri_sizes[] = {3};
-            size_t shape4[2] = {4, 4};
-            vpds_mask_desc md = vpds_default_mask_desc();
-            vpds_polygon_desc pd = vpds_default_polygon_desc();
-            vpds_mask *m2;
-            vpds_polygon *p2;
+            vpds_mask *m2 = middle_of_4x4();
+            vpds_polygon *p2 = polygon_of(tri, tri_sizes, 1);
             vpds_desc e = vpds_default_desc();
-            md.shape = shape4;
-            md.values = cells4;
-            CHECK(vpds_mask_create(&md, &m2) == VPDS_OK);
-            pd.xy = tri;
-            pd.ring_sizes = tri_sizes;
-            pd.n_rings = 1;
-            CHECK(vpds_polygon_create(&pd, &p2) == VPDS_OK);
             e.domain = vpds_mask_sdf;
             e.domain_user = m2;
             e.dim = 1;
